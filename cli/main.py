@@ -1,0 +1,91 @@
+"""designopt command line: parses arguments, calls the library, prints. No logic lives here."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from designopt.config import ConfigError, load_config
+
+app = typer.Typer(add_completion=False, no_args_is_help=True,
+                  help="Design a robot and its cell in one trajectory optimization.")
+out = Console()
+err = Console(stderr=True)
+
+
+@app.callback()
+def _group() -> None:
+    """Design a robot and its cell in one trajectory optimization."""
+
+
+def fail(message: str) -> None:
+    """A user error: one line on stderr, exit code 2, no traceback."""
+    err.print(f"[red]error:[/red] {message}", highlight=False, soft_wrap=True)
+    raise typer.Exit(code=2)
+
+
+def load(path: Path):
+    try:
+        return load_config(path)
+    except ConfigError as exc:
+        fail(str(exc))
+
+
+def solutions_table(solutions, title: str) -> Table:
+    table = Table(title=title)
+    for col in ("seed", "status", "iter", "time [s]", "design cost", "pos err [m]", "axis err", "max step",
+                "tracks"):
+        table.add_column(col, justify="right")
+    for s in sorted(solutions, key=lambda s: (not s.metrics.tracks, s.metrics.design_cost)):
+        m, r = s.metrics, s.raw
+        table.add_row(str(r.seed), r.status, str(r.iterations), f"{r.solve_time_s:.2f}", f"{m.design_cost:.4g}",
+                      f"{m.max_position_error:.1e}", f"{m.max_axis_error:.1e}", f"{m.max_joint_step:.3f}",
+                      "yes" if m.tracks else "no")
+    return table
+
+
+@app.command()
+def run(
+    config: Annotated[Path, typer.Argument(help="YAML config (see configs/ and the README).")],
+    out_dir: Annotated[Path, typer.Option("--out", help="Root of the results tree.")] = Path("results"),
+    name: Annotated[str | None, typer.Option("--name", help="Run name (default: a timestamp).")] = None,
+    no_figures: Annotated[bool, typer.Option("--no-figures", help="Skip the figures.")] = False,
+):
+    """Solve one design problem (multistart TO) and write results/<experiment>/<run>/."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from designopt.experiments.run import run_experiment
+
+    cfg = load(config)
+    with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  TimeElapsedColumn(), console=err, transient=True) as progress:
+        task = progress.add_task(f"{cfg.name}: solving {cfg.solver.multistart} starts", total=cfg.solver.multistart)
+        result = run_experiment(cfg, config.parent, out_dir, name,
+                                on_solution=lambda _s: progress.advance(task), figures=not no_figures)
+    out.print(solutions_table(result.solutions, f"{cfg.name}: {cfg.robot.structure}, "
+                                                 f"stiffness {result.solutions[0].problem.stiffness}"))
+    if result.best is None:
+        out.print("[yellow]No start tracks the path within tolerance; see summary.csv for statuses.[/yellow]")
+    else:
+        b = result.best
+        placement = b.chain.placement_values([0.0] * b.chain.n_moving, [])
+        out.print(f"best: seed {b.raw.seed}, design cost [bold]{b.metrics.design_cost:.6g}[/bold], "
+                  f"placement xyz = ({placement[0]:.3f}, {placement[1]:.3f}, {placement[2]:.3f}) m")
+    out.print(f"results: {result.directory.path}")
+
+
+def main() -> None:
+    try:
+        app()
+    except KeyboardInterrupt:
+        err.print("interrupted: finished results are in the run directory")
+        sys.exit(130)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,255 @@
+"""Experiment configuration (SPEC §8): YAML validated by pydantic.
+
+`load_config` returns a validated `Config` or raises `ConfigError` whose message is one line:
+``<file>: <key>: <reason>``. Unknown keys, wrong types and out-of-range values are all errors.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from designopt.kinematics.joints import DH_PARAMS, PLACEMENT_PARAMS
+from designopt.kinematics.presets import PRESETS
+
+
+class ConfigError(Exception):
+    """A config problem, worded as one line naming the file, the key and the reason."""
+
+    def __init__(self, file: str | Path, key: str, reason: str):
+        self.file, self.key, self.reason = str(file), key, reason
+        super().__init__(f"{file}: {key}: {reason}")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+Pair = tuple[float, float]
+Positive = Annotated[float, Field(gt=0)]
+
+
+class FigureEight(_Strict):
+    kind: Literal["figure_eight"]
+    width: Positive = 0.6
+    height: Positive = 0.3
+    waypoints: Annotated[int, Field(ge=3, le=5000)] = 80
+    force: Positive = 1.0
+
+
+class Circle(_Strict):
+    kind: Literal["circle"]
+    radius: Positive = 0.15
+    waypoints: Annotated[int, Field(ge=3, le=5000)] = 80
+    force: Positive = 1.0
+
+
+class Line(_Strict):
+    kind: Literal["line"]
+    length: Positive = 0.5
+    waypoints: Annotated[int, Field(ge=3, le=5000)] = 80
+    force: Positive = 1.0
+
+
+class CsvPath(_Strict):
+    kind: Literal["csv"]
+    file: str
+    waypoints: Annotated[int, Field(ge=3, le=5000)] | None = None
+    force: Positive = 1.0
+
+
+ToolpathConfig = Annotated[FigureEight | Circle | Line | CsvPath, Field(discriminator="kind")]
+
+
+class StiffnessConfig(_Strict):
+    revolute: Positive = Field(1.0, description="N*m/rad")
+    prismatic: Positive = Field(1.0, description="N/m")
+
+
+class BoundsConfig(_Strict):
+    length: Pair = (0.0, 2.0)
+    angle: Pair = (-math.pi, math.pi)
+    revolute: Pair = (-2 * math.pi, 2 * math.pi)
+    prismatic: Pair = (-2.0, 2.0)
+
+
+class DHRow(_Strict):
+    theta: float = 0.0
+    d: float = 0.0
+    a: float = 0.0
+    alpha: float = 0.0
+
+
+class RobotConfig(_Strict):
+    structure: Annotated[str, Field(pattern=r"^[RP]{1,12}$")] = "RRRRRR"
+    design: list[Literal["theta", "d", "a", "alpha"]] = ["d", "a", "alpha"]
+    dh: str | list[DHRow] = "puma560"
+    bounds: BoundsConfig = BoundsConfig()
+    stiffness: Positive | StiffnessConfig = 1.0
+    joint_velocity: Positive = 10.0
+
+    @field_validator("dh")
+    @classmethod
+    def _known_preset(cls, v):
+        if isinstance(v, str) and v not in {"generic", *PRESETS}:
+            raise ValueError(f"unknown preset '{v}' (known: generic, {', '.join(sorted(PRESETS))})")
+        return v
+
+
+Axis = Literal["x", "y", "z", "yaw", "pitch", "roll"]
+
+
+class PlacementConfig(_Strict):
+    optimize: bool | list[Axis] = True
+    xyz: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    ypr: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    box: tuple[Pair, Pair, Pair] = ((-2.0, 2.0), (-2.0, 2.0), (-1.0, 2.0))
+    keep_out_radius: Annotated[float, Field(ge=0)] = 0.0
+
+    @property
+    def free(self) -> tuple[str, ...]:
+        if self.optimize is True:
+            return PLACEMENT_PARAMS
+        return tuple(self.optimize) if self.optimize else ()
+
+
+class CostsConfig(_Strict):
+    tracking_weight: Positive = 1.0e4
+    regularization: Annotated[float, Field(ge=0)] = 1.0e-3
+    deflection: Literal["full", "translational"] = "full"
+    smoothness: Annotated[float, Field(ge=0)] = 1.0e-6
+
+
+class ToleranceConfig(_Strict):
+    position: Positive = 1.0e-3
+    axis: Positive = 1.0e-2
+
+
+class SolverConfig(_Strict):
+    method: Literal["to"] = "to"
+    kinematics: Literal["forward", "differential"] = "forward"
+    tracking: Literal["hard", "soft"] = "hard"
+    degree: Literal[3] = 3
+    multistart: Annotated[int, Field(ge=1, le=1000)] = 4
+    seed: Annotated[int, Field(ge=0)] = 0
+    max_iter: Annotated[int, Field(ge=1)] = 3000
+    jobs: Annotated[int, Field(ge=-1)] = -1
+    perturbation: Annotated[float, Field(ge=0)] = 0.3
+    init: Literal["ik", "constant"] = "ik"
+    time_limit: Positive = 300.0
+
+
+class Config(_Strict):
+    name: Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]+$")] = "run"
+    toolpath: ToolpathConfig = FigureEight(kind="figure_eight")
+    robot: RobotConfig = RobotConfig()
+    placement: PlacementConfig = PlacementConfig()
+    costs: CostsConfig = CostsConfig()
+    tolerance: ToleranceConfig = ToleranceConfig()
+    solver: SolverConfig = SolverConfig()
+
+
+def _key(loc: tuple) -> str:
+    """Dotted key from a pydantic error location, without union branch tags ('figure_eight', 'float')."""
+    key = ""
+    for part in loc:
+        if isinstance(part, int):
+            key += f"[{part}]"
+            continue
+        part = str(part)
+        if part in {"figure_eight", "circle", "line", "csv"} or part[:1].isupper() or not part.isidentifier():
+            continue
+        if part in {"float", "str", "bool", "int"}:
+            continue
+        key += f".{part}" if key else part
+    return key or "(top level)"
+
+
+def _semantic_errors(cfg: Config, base_dir: Path) -> list[tuple[str, str]]:
+    """Checks that span several keys; each names the key a user must change."""
+    errors = []
+    n = len(cfg.robot.structure)
+    if isinstance(cfg.robot.dh, str):
+        if cfg.robot.dh in PRESETS and len(PRESETS[cfg.robot.dh]) != n:
+            errors.append(("robot.dh", f"preset '{cfg.robot.dh}' has {len(PRESETS[cfg.robot.dh])} links, "
+                                       f"structure {cfg.robot.structure} has {n}"))
+    elif len(cfg.robot.dh) != n:
+        errors.append(("robot.dh", f"{len(cfg.robot.dh)} rows for structure {cfg.robot.structure} of {n} links"))
+    for name in ("length", "angle", "revolute", "prismatic"):
+        lo, hi = getattr(cfg.robot.bounds, name)
+        if not lo < hi:
+            errors.append((f"robot.bounds.{name}", f"lower bound {lo} must be below upper bound {hi}"))
+    if cfg.robot.bounds.length[0] < 0:
+        errors.append(("robot.bounds.length", "design lengths are >= 0 (SPEC §3); lower bound must be >= 0"))
+    for k, ((lo, hi), v) in enumerate(zip(cfg.placement.box, cfg.placement.xyz, strict=True)):
+        axis = "xyz"[k]
+        if not lo < hi:
+            errors.append((f"placement.box.{axis}", f"lower bound {lo} must be below upper bound {hi}"))
+        elif not lo <= v <= hi:
+            errors.append(("placement.xyz", f"{axis} = {v} lies outside the box [{lo}, {hi}]"))
+    if cfg.toolpath.kind == "csv":
+        path = (base_dir / cfg.toolpath.file).resolve()
+        if not path.is_file():
+            errors.append(("toolpath.file", f"no such file: {path}"))
+    return errors
+
+
+def parse_config(data: object, file: str | Path = "<config>", base_dir: Path | None = None) -> Config:
+    """Validate an already-parsed mapping; raise ConfigError on the first problem."""
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ConfigError(file, "(top level)", f"expected a mapping of keys, got {type(data).__name__}")
+    try:
+        cfg = Config.model_validate(data)
+    except ValidationError as exc:
+        # In a union, the branch that got deepest into the input is the one the user meant.
+        err = max(exc.errors(), key=lambda e: len(e["loc"]))
+        msg = err["msg"]
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key"
+        elif err["type"] == "union_tag_invalid":
+            msg = f"unknown kind {err.get('ctx', {}).get('tag')!r} (figure_eight, circle, line, csv)"
+        raise ConfigError(file, _key(err["loc"]), msg) from None
+    base = base_dir if base_dir is not None else Path(".")
+    errors = _semantic_errors(cfg, base)
+    if errors:
+        raise ConfigError(file, *errors[0])
+    return cfg
+
+
+def load_config(path: str | Path) -> Config:
+    """Read, parse and validate a YAML config file."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        raise ConfigError(path, "(file)", "no such file") from None
+    except OSError as exc:
+        raise ConfigError(path, "(file)", f"cannot read: {exc.strerror or exc}") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}" if mark is not None else "(yaml)"
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ConfigError(path, where, f"malformed YAML: {problem}") from None
+    return parse_config(data, path, path.parent)
+
+
+def dump_config(cfg: Config) -> str:
+    """The resolved config as YAML (every default filled in)."""
+    return yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False)
+
+
+def dh_rows(cfg: Config) -> list[dict[str, float]]:
+    """The initial/fixed DH table of the robot as plain dicts."""
+    from designopt.kinematics.presets import preset
+
+    if isinstance(cfg.robot.dh, str):
+        return preset(cfg.robot.dh, len(cfg.robot.structure))
+    return [{p: getattr(row, p) for p in DH_PARAMS} for row in cfg.robot.dh]

@@ -1,0 +1,68 @@
+"""Seeded multistart: solve one problem from several initial guesses in parallel (joblib).
+
+Local optima are everywhere in design problems, so several starts are part of the method. Each start is
+one joblib task; results stream back as they finish so the caller can write each at once. A worker
+process builds a problem's NLP once and reuses it for every start it is given (the cache below lives in
+the worker and holds at most two built NLPs).
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import pickle
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+from designopt.initial_guess import initial_guesses
+from designopt.problem import DesignProblem
+from designopt.solution import Solution, solve_and_evaluate
+
+# IPOPT's linear algebra gains nothing from threads at this size; parallelism is across starts.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+
+@dataclass(frozen=True)
+class Multistart:
+    """How many starts, from which seed, how far to perturb the design, and how to initialise q."""
+
+    count: int = 4
+    seed: int = 0
+    scale: float = 0.3
+    init: str = "ik"
+    jobs: int = -1
+
+
+@functools.lru_cache(maxsize=2)
+def _built(key: str, payload: bytes):
+    problem, transcription = pickle.loads(payload)
+    return transcription.build(problem)
+
+
+def solve_start(problem: DesignProblem, transcription, settings: Multistart, index: int, label: str = "") -> Solution:
+    """Build (or reuse) the NLP and solve start ``index`` of the multistart."""
+    payload = pickle.dumps((problem, transcription))
+    nlp = _built(hashlib.sha256(payload).hexdigest(), payload)
+    guess = initial_guesses(problem, index + 1, settings.seed, settings.scale, settings.init)[index]
+    return solve_and_evaluate(problem, transcription.name, nlp.solve(guess), label)
+
+
+def run_multistart(problem: DesignProblem, transcription, settings: Multistart, label: str = "") -> Iterator[Solution]:
+    """Yield one Solution per start, in the order they finish."""
+    if settings.jobs == 1 or settings.count == 1:
+        for i in range(settings.count):
+            yield solve_start(problem, transcription, settings, i, label)
+        return
+    from joblib import Parallel, delayed
+
+    n_jobs = min(settings.count, os.cpu_count() or 1) if settings.jobs == -1 else settings.jobs
+    parallel = Parallel(n_jobs=n_jobs, return_as="generator_unordered")
+    yield from parallel(delayed(solve_start)(problem, transcription, settings, i, label) for i in range(settings.count))
+
+
+def best_solution(solutions) -> Solution | None:
+    """The tracking solution with the lowest design cost (None if no start tracks)."""
+    tracking = [s for s in solutions if s.metrics.tracks]
+    return min(tracking, key=lambda s: s.metrics.design_cost) if tracking else None

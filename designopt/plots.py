@@ -1,0 +1,109 @@
+"""Figures of solutions (PNG + PDF, labelled axes with units). Pure functions: data in, files out."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from designopt.kinematics.chain import link_frames, placement_pose, tool_pose  # noqa: E402
+from designopt.solution import Solution  # noqa: E402
+
+plt.rcParams.update({"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "savefig.dpi": 200})
+
+
+def save(fig, directory: Path, stem: str) -> list[Path]:
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = [directory / f"{stem}.png", directory / f"{stem}.pdf"]
+    for p in paths:
+        fig.savefig(p, bbox_inches="tight")
+    plt.close(fig)
+    return paths
+
+
+def _equal_3d(ax, points: np.ndarray) -> None:
+    centre = points.mean(axis=0)
+    radius = max(np.ptp(points, axis=0).max() / 2, 0.05)
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=True):
+        setter(c - radius, c + radius)
+    ax.set_box_aspect((1, 1, 1))
+
+
+def draw_robot(ax, sol: Solution, q: np.ndarray, color: str = "C0", path: bool = True) -> np.ndarray:
+    """Draw the chain at joint values q (a polyline through the DH frame origins), the base and the
+    placed toolpath, in the base frame B. Returns the points drawn (for axis limits)."""
+    chain = sol.chain
+    frames = link_frames(chain, q, np.zeros(0))
+    tool = tool_pose(chain, q, np.zeros(0))
+    origins = np.array([T[:3, 3] for T in frames] + [tool[:3, 3]])
+    ax.plot(*origins.T, "-o", color=color, lw=3, ms=4, label=f"{chain.structure} robot")
+    ax.scatter(0, 0, 0, marker="s", s=60, color="k", label="base B")
+    drawn = [origins]
+    if path:
+        T_BW = placement_pose(chain, q, np.zeros(0))
+        s_B = (T_BW[:3, :3] @ sol.problem.toolpath.points_W.T).T + T_BW[:3, 3]
+        ax.plot(*s_B.T, "-", color="C3", lw=1.5, label="toolpath (placed)")
+        for axis, c in zip(range(3), ("r", "g", "b"), strict=True):
+            end = T_BW[:3, 3] + 0.1 * T_BW[:3, axis]
+            ax.plot(*np.c_[T_BW[:3, 3], end], color=c, lw=1)
+        drawn.append(s_B)
+    return np.vstack(drawn)
+
+
+def robot_figure(sol: Solution, title: str | None = None):
+    fig = plt.figure(figsize=(5.5, 5))
+    ax = fig.add_subplot(projection="3d")
+    pts = draw_robot(ax, sol, sol.raw.Q[0])
+    _equal_3d(ax, np.vstack([pts, np.zeros((1, 3))]))
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    ax.set_title(title or f"{sol.problem.chain.structure}: design cost {sol.metrics.design_cost:.3g} (start pose)")
+    ax.legend(loc="upper left", fontsize=7)
+    return fig
+
+
+def joint_figure(sol: Solution):
+    structure, t, Q = sol.problem.chain.structure, sol.problem.toolpath.t, sol.raw.Q
+    fig, axes = plt.subplots(2, 1, figsize=(6, 4.5), sharex=True)
+    for i, c in enumerate(structure):
+        ax = axes[0] if c == "R" else axes[1]
+        ax.plot(t, Q[:, i], label=f"q{i + 1} ({c})")
+    axes[0].set_ylabel("revolute joints [rad]")
+    axes[1].set_ylabel("prismatic joints [m]")
+    axes[1].set_xlabel("task time t [-]")
+    for ax in axes:
+        if ax.lines:
+            ax.legend(fontsize=7, ncol=3)
+    axes[0].set_title(f"Joint trajectories (max step {sol.metrics.max_joint_step:.3g} between waypoints)")
+    return fig
+
+
+def deformation_figure(sol: Solution):
+    tp, m = sol.problem.toolpath, sol.metrics
+    fig, (a0, a1) = plt.subplots(1, 2, figsize=(8, 3.2))
+    sc = a0.scatter(tp.points_W[:, 0], tp.points_W[:, 1], c=m.deformation, cmap="viridis", s=14)
+    a0.set_aspect("equal")
+    a0.set_xlabel("x_W [m]")
+    a0.set_ylabel("y_W [m]")
+    a0.set_title("Deformation cost along the path")
+    fig.colorbar(sc, ax=a0, label="L_d")
+    a1.plot(tp.t, m.deformation, color="C2")
+    a1.set_xlabel("task time t [-]")
+    a1.set_ylabel(f"L_d ({sol.problem.deflection})")
+    a1.set_title(f"design cost = sum dt L_d = {m.design_cost:.4g}")
+    fig.tight_layout()
+    return fig
+
+
+def solution_figures(sol: Solution, directory: Path) -> list[Path]:
+    """The three standard figures of one solution."""
+    out = []
+    out += save(robot_figure(sol), directory, "robot")
+    out += save(joint_figure(sol), directory, "joints")
+    out += save(deformation_figure(sol), directory, "deformation")
+    return out

@@ -1,0 +1,68 @@
+"""Run directories (SPEC §7): results/<experiment>/<run-name>/ with config, summary, solutions, figures, log.
+
+Every row of summary.csv is appended and flushed as soon as its solve finishes, and every solution file is
+written atomically, so a run that dies keeps everything it finished.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as dt
+import os
+from pathlib import Path
+
+SUMMARY_COLUMNS = [
+    "experiment", "case", "method", "structure", "dof", "n_prismatic", "n_design_joints",
+    "design_cost", "max_position_error", "max_axis_error", "max_joint_step", "tracks", "best",
+    "status", "success", "iterations", "solve_time_s", "build_time_s", "n_variables", "n_constraints",
+    "objective", "regularization", "min_standoff", "kinematic_drift", "seed",
+    "stiffness_revolute", "stiffness_prismatic", "deflection", "solution_file",
+]
+
+
+def default_run_name() -> str:
+    return dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+
+
+class RunDirectory:
+    """One run's directory and the files in it."""
+
+    def __init__(self, path: Path):
+        self.path = Path(path)
+        self.solutions = self.path / "solutions"
+        self.figures = self.path / "figures"
+        for d in (self.path, self.solutions, self.figures):
+            d.mkdir(parents=True, exist_ok=True)
+
+    @classmethod
+    def create(cls, root: Path, experiment: str, name: str | None = None) -> RunDirectory:
+        return cls(Path(root) / experiment / (name or default_run_name()))
+
+    @property
+    def summary(self) -> Path:
+        return self.path / "summary.csv"
+
+    def write_config(self, text: str) -> None:
+        (self.path / "config.yaml").write_text(text)
+
+    def append_row(self, row: dict) -> None:
+        """Append one row to summary.csv (header written with the first row), flushed to disk."""
+        new = not self.summary.exists()
+        with self.summary.open("a", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore")
+            if new:
+                writer.writeheader()
+            writer.writerow({k: _fmt(row.get(k, "")) for k in SUMMARY_COLUMNS})
+            fh.flush()
+            os.fsync(fh.fileno())
+
+    def log(self, message: str) -> None:
+        stamp = dt.datetime.now().isoformat(timespec="seconds")
+        with (self.path / "run.log").open("a") as fh:
+            fh.write(f"{stamp} {message}\n")
+
+
+def _fmt(value):
+    if isinstance(value, float):
+        return repr(value)
+    return value

@@ -1,0 +1,141 @@
+"""Solutions: one solved design, its metrics, and its JSON file (schema ``designopt.solution/1``).
+
+The file holds everything needed to check a result without designopt: the DH table with the moving
+parameter of each link set to null, the tool transform, the placement, the stiffness, the force scale,
+the toolpath in W with its forces, the joint values at every waypoint, and the metrics.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from designopt.evaluation import Metrics, evaluate
+from designopt.kinematics.joints import DH_PARAMS, Chain, Role
+from designopt.problem import DesignProblem
+from designopt.transcriptions.base import RawResult
+
+SCHEMA = "designopt.solution/1"
+
+
+@dataclass(frozen=True)
+class Solution:
+    """A solved design: the problem it answers, where the solver ended, and the metrics there."""
+
+    problem: DesignProblem
+    method: str
+    raw: RawResult
+    metrics: Metrics
+    label: str = ""
+
+    @property
+    def chain(self) -> Chain:
+        """The problem's chain with every design joint fixed at its solved value (only q moves)."""
+        values = dict(zip([j.name for j in self.problem.chain.design], self.raw.q_d, strict=True))
+        return self.problem.chain.with_roles(dict.fromkeys(values, Role.FIXED), values)
+
+    def row(self) -> dict:
+        """One summary.csv row (without experiment/case columns, which the caller adds)."""
+        structure = self.problem.chain.structure
+        r = self.raw
+        return {
+            "method": self.method,
+            "structure": structure,
+            "dof": len(structure),
+            "n_prismatic": structure.count("P"),
+            "n_design_joints": self.problem.chain.n_design,
+            **self.metrics.row(),
+            "status": r.status,
+            "success": r.success,
+            "iterations": r.iterations,
+            "solve_time_s": r.solve_time_s,
+            "build_time_s": r.build_time_s,
+            "n_variables": r.n_variables,
+            "n_constraints": r.n_constraints,
+            "objective": r.objective,
+            "kinematic_drift": r.kinematic_drift,
+            "seed": r.seed,
+            "stiffness_revolute": self.problem.stiffness.revolute,
+            "stiffness_prismatic": self.problem.stiffness.prismatic,
+            "deflection": self.problem.deflection,
+        }
+
+
+def solve_and_evaluate(problem: DesignProblem, method: str, raw: RawResult, label: str = "") -> Solution:
+    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.Q), label)
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def to_dict(sol: Solution) -> dict:
+    """The solution as a JSON-ready dict in schema designopt.solution/1."""
+    chain, p = sol.chain, sol.problem
+    links = chain.link_values(np.zeros(chain.n_moving), np.zeros(0))
+    dh = []
+    for link_type, params in zip(chain.structure, links, strict=True):
+        row = {"type": link_type}
+        for name, value in zip(DH_PARAMS, params, strict=True):
+            moving = (name == "theta" and link_type == "R") or (name == "d" and link_type == "P")
+            row[name] = None if moving else float(value)
+        dh.append(row)
+    placement = chain.placement_values(np.zeros(chain.n_moving), np.zeros(0))
+    m, r = sol.metrics, sol.raw
+    return {
+        "schema": SCHEMA,
+        "method": sol.method,
+        "structure": chain.structure,
+        "dh": dh,
+        "tool": [list(map(float, row)) for row in chain.tool],
+        "placement": {"xyz": [float(v) for v in placement[:3]], "ypr": [float(v) for v in placement[3:]]},
+        "stiffness": [float(k) for k in p.stiffness.diagonal(chain.structure)],
+        "force_alpha": float(np.linalg.norm(p.toolpath.force_W[0])),
+        "toolpath": {
+            "kind": p.toolpath.kind,
+            "t": p.toolpath.t.tolist(),
+            "points_W": p.toolpath.points_W.tolist(),
+            "force_W": p.toolpath.force_W.tolist(),
+        },
+        "q": np.asarray(r.Q).tolist(),
+        "design_joints": {j.name: float(v) for j, v in zip(p.chain.design, r.q_d, strict=True)},
+        "metrics": {
+            "design_cost": m.design_cost,
+            "max_position_error": m.max_position_error,
+            "max_axis_error": m.max_axis_error,
+            "tracks": m.tracks,
+            "max_joint_step": m.max_joint_step,
+            "deflection": p.deflection,
+            "status": r.status,
+            "iterations": r.iterations,
+            "solve_time_s": r.solve_time_s,
+            "regularization": m.regularization,
+            "min_standoff": m.min_standoff,
+            "kinematic_drift": r.kinematic_drift,
+            "objective": _finite(r.objective),
+            "seed": r.seed,
+            "tolerances": {"position": p.position_tol, "axis": p.axis_tol},
+            "stiffness_model": {"revolute_Nm_per_rad": p.stiffness.revolute,
+                                "prismatic_N_per_m": p.stiffness.prismatic},
+        },
+    }
+
+
+def write_json(data: dict, path: Path) -> None:
+    """Write JSON atomically (temporary file + rename), so a killed run never leaves half a file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.NamedTemporaryFile("w", dir=path.parent, suffix=".tmp", delete=False) as fh:
+        json.dump(data, fh, indent=1)
+        tmp = fh.name
+    os.replace(tmp, path)
+
+
+def write_solution(sol: Solution, path: Path) -> None:
+    write_json(to_dict(sol), path)
+

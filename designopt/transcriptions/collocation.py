@@ -1,0 +1,242 @@
+"""TO: direct collocation of the design problem (the paper's method, SPEC §4).
+
+Moving joints follow C^1 piecewise-cubic (Hermite) trajectories with knots at the waypoints: the knot
+states are (q_k, v_k = dq/dt), so position and velocity are continuous by construction and one cubic
+spans each interval. Design joints are degree-0: one decision variable each for the whole task. Joint
+position and velocity bounds hold at the knots and at every interval midpoint (the collocation points).
+
+Tracking is ``hard`` (position and tool axis as equality constraints at every waypoint; default) or
+``soft`` (the paper's penalty w * L_t). Kinematics is ``forward`` (p = FK(q)) or ``differential``
+(p is a state with dp/dt = J(q) dq/dt, integrated by Simpson's rule over each interval, p_0 = FK(q_0)).
+
+The NLP is built once per problem; `CollocationNLP.solve` then runs from any number of initial guesses.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from designopt.problem import DesignProblem
+from designopt.transcriptions.base import InitialGuess, RawResult, ipopt_options, waypoint_function
+from designopt.transcriptions.compiled import COMPILE_MODES
+from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
+
+Z_DOWN = np.array([0.0, 0.0, -1.0])
+
+
+def hermite_midpoint(q0, v0, q1, v1, h):
+    """Position and velocity of the cubic Hermite segment at its midpoint (numpy or CasADi)."""
+    q_mid = 0.5 * (q0 + q1) + h * (v0 - v1) / 8.0
+    v_mid = 1.5 * (q1 - q0) / h - 0.25 * (v0 + v1)
+    return q_mid, v_mid
+
+
+def hermite_acceleration_integral(q0, v0, q1, v1, h):
+    """Integral of the squared acceleration over one cubic Hermite segment (exact), per joint."""
+    a0 = 6.0 * (q1 - q0) / h**2 - (4.0 * v0 + 2.0 * v1) / h
+    a1 = -6.0 * (q1 - q0) / h**2 + (2.0 * v0 + 4.0 * v1) / h
+    return h / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)
+
+
+def waypoint_terms(problem: DesignProblem, tracking: str, position_in_terms: bool):
+    """Cost phi_k and constraints c_k at one waypoint as a function of y_k = (q_k, q_d).
+
+    Returns the CasADi function (y, s_W, f_W) -> (phi, c) and the bounds of c. The tracking position
+    enters here only when p = FK(q) (forward kinematics); in differential mode it is the state p.
+    """
+    chain, tp = problem.chain, problem.toolpath
+    n_m, n_d, h = chain.n_moving, chain.n_design, tp.dt
+    y = ca.SX.sym("y", n_m + n_d)
+    s_W, f_W = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3)
+    p_W, z_W, L_d, rho2, _ = waypoint_function(problem)(y[:n_m], y[n_m:], s_W, f_W)
+    phi = h * L_d
+    c, lo, hi = [], [], []
+    if tracking == "soft":
+        L_t = ca.sumsqr(z_W - ca.DM(Z_DOWN)) + (ca.sumsqr(p_W - s_W) if position_in_terms else 0)
+        phi += h * problem.tracking_weight * L_t
+    else:
+        if position_in_terms:
+            c.append(p_W - s_W)
+            lo += [0.0] * 3
+            hi += [0.0] * 3
+        c.append(z_W)  # (0, 0, <= 0): the axis points into the surface; the sign excludes z = -z*
+        lo += [0.0, 0.0, -np.inf]
+        hi += [0.0, 0.0, 0.0]
+    if problem.keep_out_radius > 0:
+        c.append(rho2)
+        lo.append(problem.keep_out_radius**2)
+        hi.append(np.inf)
+    fn = ca.Function("terms", [y, s_W, f_W], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
+                     ["y", "s_W", "f_W"], ["phi", "c"])
+    return fn, np.array(lo), np.array(hi)
+
+
+@dataclass(frozen=True)
+class Collocation:
+    """The TO transcription: swap it for another transcription of the same DesignProblem.
+
+    ``hessian``: ``structured`` assembles the exact Hessian from per-waypoint blocks (forward kinematics
+    only), ``auto`` lets CasADi differentiate the whole graph. ``compile``: C-compile the block function
+    (``none``, ``O0``, ``O1``, ``O2``).
+    """
+
+    kinematics: str = "forward"
+    tracking: str = "hard"
+    degree: int = 3
+    max_iter: int = 3000
+    hessian: str = "structured"
+    compile: str = "O0"
+    ipopt: dict = field(default_factory=dict)
+
+    name = "to"
+
+    def __post_init__(self):
+        if self.degree != 3:
+            raise ValueError("only degree 3 (C^1 cubic Hermite) collocation is implemented")
+        if self.kinematics not in ("forward", "differential"):
+            raise ValueError(f"kinematics must be forward or differential, got {self.kinematics!r}")
+        if self.tracking not in ("hard", "soft"):
+            raise ValueError(f"tracking must be hard or soft, got {self.tracking!r}")
+        if self.hessian not in ("structured", "auto"):
+            raise ValueError(f"hessian must be structured or auto, got {self.hessian!r}")
+        if self.compile not in COMPILE_MODES:
+            raise ValueError(f"compile must be one of {COMPILE_MODES}, got {self.compile!r}")
+
+    def build(self, problem: DesignProblem) -> CollocationNLP:
+        return CollocationNLP(problem, self)
+
+
+class CollocationNLP:
+    """The built NLP of one problem; `solve` runs IPOPT from an initial guess."""
+
+    def __init__(self, problem: DesignProblem, scheme: Collocation):
+        t0 = time.perf_counter()
+        self.problem, self.scheme = problem, scheme
+        chain, tp = problem.chain, problem.toolpath
+        n_m, n_d, N, h = chain.n_moving, chain.n_design, tp.n, tp.dt
+        differential = scheme.kinematics == "differential"
+        self.n_state = 2 * n_m + (3 if differential else 0)
+
+        q_d = ca.SX.sym("q_d", n_d)
+        Z = ca.SX.sym("Z", self.n_state, N)  # column k: (q_k, v_k[, p_k])
+        x = ca.vertcat(q_d, ca.vec(Z))
+        Q, V = Z[:n_m, :], Z[n_m : 2 * n_m, :]
+        S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
+        Y = ca.vertcat(Q, ca.repmat(q_d, 1, N))
+
+        terms, c_lo, c_hi = waypoint_terms(problem, scheme.tracking, position_in_terms=not differential)
+        Phi, C = terms.map(N)(Y, S, F)
+
+        Q0, V0, Q1, V1 = Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:]
+        Q_mid, V_mid = hermite_midpoint(Q0, V0, Q1, V1, h)
+        quadratic = 0
+        if problem.regularized:
+            quadratic += problem.regularization * ca.sumsqr(q_d[problem.regularized])
+        if problem.smoothness > 0:
+            # Squared acceleration, plus the same weight on h |q_k|^2: a constant joint offset (e.g. q_1
+            # against the placement yaw) is otherwise an exact null direction that stalls IPOPT.
+            quadratic += problem.smoothness * (
+                ca.sum1(ca.sum2(hermite_acceleration_integral(Q0, V0, Q1, V1, h))) + h * ca.sumsqr(Q)
+            )
+        objective = ca.sum2(Phi) + quadratic
+
+        g, lbg, ubg = [], [], []
+
+        def add(expr, lo, hi):
+            expr = ca.vec(expr)  # column-major, like the bounds
+            g.append(expr)
+            lbg.append(np.broadcast_to(np.ravel(lo, order="F"), expr.shape[0]))
+            ubg.append(np.broadcast_to(np.ravel(hi, order="F"), expr.shape[0]))
+
+        n_c = C.shape[0]
+        add(C, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)))  # first: multipliers 0..n_c N
+
+        if differential:
+            P = Z[2 * n_m :, :]
+            wp = waypoint_function(problem)
+            p_W, _, _, _, Jv = wp.map(N)(Q, ca.repmat(q_d, 1, N), S, F)
+            _, _, _, _, Jv_mid = wp.map(N - 1)(Q_mid, ca.repmat(q_d, 1, N - 1), S[:, :-1], F[:, :-1])
+            pdot, pdot_mid = _pdot(Jv, V, n_m, N), _pdot(Jv_mid, V_mid, n_m, N - 1)
+            add(P[:, 0] - p_W[:, 0], 0.0, 0.0)
+            add(P[:, 1:] - P[:, :-1] - h / 6.0 * (pdot[:, :-1] + 4 * pdot_mid + pdot[:, 1:]), 0.0, 0.0)
+            if scheme.tracking == "hard":
+                add(P - S, 0.0, 0.0)
+            else:
+                objective += h * problem.tracking_weight * ca.sumsqr(P - S)
+            self._drift = ca.Function("drift", [x], [ca.mmax(ca.sqrt(ca.sum1((P - p_W) ** 2)))])
+
+        lo_m = np.array([j.lower for j in chain.moving])
+        hi_m = np.array([j.upper for j in chain.moving])
+        vmax = problem.joint_velocity
+        add(Q_mid, np.tile(lo_m[:, None], (1, N - 1)), np.tile(hi_m[:, None], (1, N - 1)))
+        add(V_mid, -vmax, vmax)
+
+        n_free = self.n_state - 2 * n_m
+        state_lo = np.concatenate([lo_m, -vmax * np.ones(n_m), -np.inf * np.ones(n_free)])
+        state_hi = np.concatenate([hi_m, vmax * np.ones(n_m), np.inf * np.ones(n_free)])
+        self.lbx = np.concatenate([[j.lower for j in chain.design], np.tile(state_lo, N)])
+        self.ubx = np.concatenate([[j.upper for j in chain.design], np.tile(state_hi, N)])
+        self.lbg, self.ubg = np.concatenate(lbg), np.concatenate(ubg)
+        g = ca.vertcat(*g)
+        self.n_variables, self.n_constraints = x.shape[0], g.shape[0]
+
+        opts = ipopt_options(scheme.max_iter, scheme.ipopt)
+        if scheme.hessian == "structured" and not differential:
+            constant = np.array(ca.evalf(ca.hessian(quadratic, x)[0])) if problem.regularized or \
+                problem.smoothness > 0 else np.zeros((x.shape[0], x.shape[0]))
+            block = block_hessian_function(terms, n_m + n_d, n_c, scheme.compile)
+            q_index = n_d + np.arange(N)[:, None] * self.n_state + np.arange(n_m)[None, :]
+            y_index = np.hstack([q_index, np.tile(np.arange(n_d), (N, 1))])
+            mu_index = np.arange(N * n_c).reshape(N, n_c)
+            opts["hess_lag"] = assemble_hessian(
+                self.n_variables, self.n_constraints, block, y_index, lambda _x: [S, F], mu_index, constant
+            )
+        self.solver = ca.nlpsol("to", "ipopt", {"x": x, "f": objective, "g": g}, opts)
+        self.build_time_s = time.perf_counter() - t0
+
+    def _pack(self, guess: InitialGuess) -> np.ndarray:
+        p = self.problem
+        Q = np.asarray(guess.Q, dtype=float)
+        V = np.gradient(Q, p.toolpath.t, axis=0) if guess.V is None else np.asarray(guess.V, dtype=float)
+        V = np.clip(V, -p.joint_velocity, p.joint_velocity)
+        blocks = [Q, V]
+        if self.scheme.kinematics == "differential":
+            blocks.append(np.asarray(p.toolpath.points_W))
+        Z = np.hstack(blocks)  # row k = column k of the symbolic Z
+        return np.concatenate([np.asarray(guess.q_d, dtype=float), Z.ravel()])
+
+    def solve(self, guess: InitialGuess) -> RawResult:
+        """Run IPOPT from one guess. A failed solve is a result with its status, not an exception."""
+        x0 = np.clip(self._pack(guess), self.lbx, self.ubx)
+        t0 = time.perf_counter()
+        sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        wall = time.perf_counter() - t0
+        stats = self.solver.stats()
+        x = np.asarray(sol["x"]).ravel()
+        n_d, n_m, N = self.problem.chain.n_design, self.problem.chain.n_moving, self.problem.toolpath.n
+        Z = x[n_d:].reshape(N, self.n_state)
+        drift = float(self._drift(x)) if self.scheme.kinematics == "differential" else 0.0
+        return RawResult(
+            q_d=x[:n_d],
+            Q=Z[:, :n_m],
+            V=Z[:, n_m : 2 * n_m],
+            status=str(stats.get("return_status", "unknown")),
+            success=bool(stats.get("success", False)),
+            iterations=int(stats.get("iter_count", -1)),
+            solve_time_s=wall,
+            build_time_s=self.build_time_s,
+            objective=float(sol["f"]),
+            n_variables=self.n_variables,
+            n_constraints=self.n_constraints,
+            seed=guess.seed,
+            kinematic_drift=drift,
+        )
+
+
+def _pdot(Jv_W, V, n_m: int, n: int):
+    """dp/dt = Jv(q) v at n points, from the horizontally stacked 3 x (n_m n) Jacobians of a map."""
+    return ca.horzcat(*[Jv_W[:, k * n_m : (k + 1) * n_m] @ V[:, k] for k in range(n)])

@@ -1,0 +1,63 @@
+"""Compile small CasADi functions to C, with an on-disk cache keyed by the generated source.
+
+Only per-waypoint functions are compiled (a few thousand lines of C, seconds); compiling a whole NLP
+takes minutes. The cache lives in ``$DESIGNOPT_CACHE`` or ``~/.cache/designopt`` and is safe to share
+between processes: each library is written under a temporary name and renamed into place.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+
+import casadi as ca
+
+COMPILE_MODES = ("none", "O0", "O1", "O2")
+
+
+def cache_dir() -> Path:
+    path = Path(os.environ.get("DESIGNOPT_CACHE", Path.home() / ".cache" / "designopt"))
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def compiled(fn: ca.Function, mode: str = "O0") -> ca.Function:
+    """Return ``fn`` evaluated as compiled C (mode O0/O1/O2), or unchanged for mode ``none``.
+
+    Falls back to the interpreted function if no C compiler works, so a machine without gcc is slower,
+    not broken.
+    """
+    if mode == "none":
+        return fn
+    if mode not in COMPILE_MODES:
+        raise ValueError(f"compile must be one of {COMPILE_MODES}, got {mode!r}")
+    with tempfile.TemporaryDirectory() as tmp:
+        gen = ca.CodeGenerator(f"{fn.name()}.c", {"with_header": False})
+        gen.add(fn)
+        source_path = Path(gen.generate(tmp + os.sep))
+        source = source_path.read_text()
+    key = hashlib.sha256((source + mode + ca.__version__).encode()).hexdigest()[:20]
+    library = cache_dir() / f"{fn.name()}_{key}.so"
+    if not library.exists():
+        try:
+            _build(source, library, mode)
+        except (OSError, subprocess.CalledProcessError):
+            return fn
+    return ca.external(fn.name(), str(library))
+
+
+def _build(source: str, library: Path, mode: str) -> None:
+    with tempfile.TemporaryDirectory(dir=library.parent) as tmp:
+        c_file = Path(tmp) / "fn.c"
+        c_file.write_text(source)
+        tmp_lib = Path(tmp) / library.name
+        compiler = os.environ.get("CC", "gcc")
+        subprocess.run(
+            [compiler, f"-{mode}", "-fPIC", "-shared", str(c_file), "-o", str(tmp_lib), "-lm"],
+            check=True,
+            capture_output=True,
+        )
+        os.replace(tmp_lib, library)
