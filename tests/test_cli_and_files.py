@@ -1,0 +1,87 @@
+"""The CLI end to end through Typer's CliRunner, and every solution file re-checked independently."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+import pytest
+import yaml
+from conftest import gantry_config
+from typer.testing import CliRunner
+
+from cli.main import app
+from designopt.verify import verify_file
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory):
+    root = tmp_path_factory.mktemp("run")
+    config = root / "gantry.yaml"
+    cfg = gantry_config(solver={"multistart": 2, "jobs": 1, "max_iter": 200})
+    cfg["placement"]["optimize"] = ["x", "z"]
+    config.write_text(yaml.safe_dump(cfg))
+    result = runner.invoke(app, ["run", str(config), "--out", str(root / "results"), "--name", "t"])
+    return result, root / "results" / "gantry" / "t"
+
+
+def test_run_writes_the_run_directory(finished_run):
+    result, run = finished_run
+    assert result.exit_code == 0, result.output
+    assert "design cost" in result.output
+    for name in ("config.yaml", "summary.csv", "run.log", "best.json"):
+        assert (run / name).is_file(), name
+    for stem in ("robot", "joints", "deformation"):
+        assert (run / "figures" / f"{stem}.png").stat().st_size > 1000
+        assert (run / "figures" / f"{stem}.pdf").is_file()
+    summary = pd.read_csv(run / "summary.csv")
+    assert len(summary) == 2
+    required = ["experiment", "case", "method", "structure", "dof", "n_prismatic", "design_cost",
+                "max_position_error", "max_axis_error", "max_joint_step", "tracks", "status", "iterations",
+                "solve_time_s", "seed", "solution_file"]
+    assert set(required) <= set(summary.columns)
+    assert summary["best"].sum() == 1
+    assert (summary["stiffness_revolute"] == 1.0).all()
+
+
+def test_every_solution_file_reverifies(finished_run):
+    _, run = finished_run
+    files = sorted((run / "solutions").glob("*.json")) + [run / "best.json"]
+    assert len(files) == 3
+    for f in files:
+        data = json.loads(f.read_text())
+        assert data["schema"] == "designopt.solution/1"
+        assert [row["d"] for row in data["dh"]] == [None, None, None]  # P links: d moves
+        assert len(data["q"]) == len(data["toolpath"]["t"])
+        assert verify_file(f) == [], f
+
+
+def test_verifier_catches_a_wrong_cost(finished_run, tmp_path):
+    _, run = finished_run
+    data = json.loads((run / "best.json").read_text())
+    data["metrics"]["design_cost"] *= 1.001
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    assert any("design_cost" in p for p in verify_file(bad))
+    data["metrics"]["design_cost"] /= 1.001
+    data["q"][3][0] += 0.01  # the tool leaves the path by 1 cm at one waypoint
+    bad.write_text(json.dumps(data))
+    assert any("max_position_error" in p for p in verify_file(bad))
+
+
+@pytest.mark.parametrize("text", ["solver: {max_iter: -3}\n", "robot: {colour: red}\n", "toolpath: [1, 2\n"])
+def test_bad_config_exits_2_with_one_line(tmp_path, text):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    result = runner.invoke(app, ["run", str(path), "--out", str(tmp_path)])
+    assert result.exit_code == 2
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and str(path) in lines[0] and "Traceback" not in result.output
+
+
+def test_missing_config_exits_2(tmp_path):
+    result = runner.invoke(app, ["run", str(tmp_path / "nope.yaml")])
+    assert result.exit_code == 2
+    assert "no such file" in result.output

@@ -1,0 +1,115 @@
+"""TO on problems with known answers, and its Hessian against CasADi's own differentiation."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+from conftest import gantry_config
+
+from designopt.config import parse_config
+from designopt.initial_guess import initial_guesses
+from designopt.problem import problem_from_config
+from designopt.solution import solve_and_evaluate
+from designopt.transcriptions import Collocation
+from designopt.transcriptions.collocation import hermite_acceleration_integral, hermite_midpoint
+
+
+def test_hermite_formulas_match_the_cubic(rng):
+    q0, v0, q1, v1, h = rng.normal(size=5)
+    h = abs(h) + 0.1
+    # Cubic through (0, q0, v0) and (h, q1, v1), solved directly.
+    A = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [1, h, h**2, h**3], [0, 1, 2 * h, 3 * h**2]])
+    c = np.linalg.solve(A, [q0, v0, q1, v1])
+    q_mid, v_mid = hermite_midpoint(q0, v0, q1, v1, h)
+    assert q_mid == pytest.approx(np.polyval(c[::-1], h / 2))
+    assert v_mid == pytest.approx(np.polyval(np.polyder(c[::-1]), h / 2))
+    ts = np.linspace(0, h, 20001)
+    acc = np.polyval(np.polyder(c[::-1], 2), ts)
+    assert hermite_acceleration_integral(q0, v0, q1, v1, h) == pytest.approx(np.trapezoid(acc**2, ts), rel=1e-6)
+
+
+def test_gantry_known_optimum():
+    """A Cartesian gantry with K = I has J_v J_v^T = I, so C w = (F, 0) at every pose: L_d = alpha^2 and
+    the design cost is alpha^2 N / (N - 1) for any design. The offsets a_i only pay regularisation, so the
+    optimum has a = 0 (exactly so without the tiny joint regularisation, which trades against it)."""
+    problem = problem_from_config(parse_config(gantry_config(costs={"smoothness": 0.0})))
+    nlp = Collocation().build(problem)
+    guess = initial_guesses(problem, 1, seed=0, scale=0.3, mode="constant")[0]
+    sol = solve_and_evaluate(problem, "to", nlp.solve(guess))
+    N, alpha = problem.toolpath.n, 2.0
+    assert sol.raw.success, sol.raw.status
+    assert sol.metrics.tracks
+    assert sol.metrics.design_cost == pytest.approx(alpha**2 * N / (N - 1), rel=1e-9)
+    # a = 0 lies on the bound a >= 0 where the gradient also vanishes; an interior-point method stops at
+    # a ~ sqrt(mu / (2 lambda)) with mu ~ 1e-9, lambda = 1e-3, i.e. ~1e-3 m.
+    assert np.all(sol.raw.q_d >= 0) and np.all(sol.raw.q_d < 3e-3)
+    # Line along x_W maps to base z under pitch -pi/2: only d1 moves, by the line's length.
+    assert np.ptp(sol.raw.Q[:, 0]) == pytest.approx(0.2, abs=1e-6)
+
+
+@pytest.mark.parametrize("tracking", ["hard", "soft"])
+def test_soft_and_differential_variants_solve_the_gantry(tracking):
+    problem = problem_from_config(parse_config(gantry_config()))
+    for kinematics in ("forward", "differential"):
+        nlp = Collocation(tracking=tracking, kinematics=kinematics, hessian="auto" if kinematics ==
+                          "differential" else "structured").build(problem)
+        guess = initial_guesses(problem, 1, 0, 0.3, "constant")[0]
+        raw = nlp.solve(guess)
+        sol = solve_and_evaluate(problem, "to", raw)
+        assert raw.success, (tracking, kinematics, raw.status)
+        # soft tracking leaves a residual of order 1/w; hard tracks exactly
+        assert sol.metrics.max_position_error < (1e-6 if tracking == "hard" else 1e-3)
+        assert raw.kinematic_drift < 1e-6  # straight line, constant J: Simpson is exact
+
+
+
+@pytest.mark.parametrize("tracking,keep_out", [("hard", 0.0), ("soft", 0.0), ("hard", 0.2)])
+def test_structured_hessian_equals_casadi_hessian(tracking, keep_out, rng):
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 7},
+           "robot": {"structure": "RPRR", "dh": "generic"},
+           "placement": {"xyz": [0.4, 0.1, 0.0], "keep_out_radius": keep_out}}
+    problem = problem_from_config(parse_config(cfg))
+    ours = Collocation(tracking=tracking, hessian="structured", compile="none").build(problem)
+    ref = Collocation(tracking=tracking, hessian="auto").build(problem)
+    n_x, n_g = ours.n_variables, ours.n_constraints
+    assert (n_x, n_g) == (ref.n_variables, ref.n_constraints)
+    H_ours = ours.solver.get_function("nlp_hess_l")
+    H_ref = ref.solver.get_function("nlp_hess_l")
+    for _ in range(3):
+        x, lam_f, lam_g = rng.normal(size=n_x), rng.uniform(0.5, 2), rng.normal(size=n_g)
+        a = np.triu(np.array(ca.DM(H_ours(x, [], lam_f, lam_g))))
+        b = np.triu(np.array(ca.DM(H_ref(x, [], lam_f, lam_g))))
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
+
+
+def test_compiled_block_gives_the_same_hessian(rng, tmp_path, monkeypatch):
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 5}, "robot": {"structure": "RR", "dh": "generic"}}
+    problem = problem_from_config(parse_config(cfg))
+    a = Collocation(compile="O0").build(problem)
+    b = Collocation(compile="none").build(problem)
+    assert list(tmp_path.glob("*.so")), "the block function was not compiled"
+    x, lam_g = rng.normal(size=a.n_variables), rng.normal(size=a.n_constraints)
+    Ha = np.array(ca.DM(a.solver.get_function("nlp_hess_l")(x, [], 1.0, lam_g)))
+    Hb = np.array(ca.DM(b.solver.get_function("nlp_hess_l")(x, [], 1.0, lam_g)))
+    np.testing.assert_allclose(Ha, Hb, rtol=1e-12, atol=1e-12)
+
+
+def test_ik_start_tracks_a_reachable_path():
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 20},
+           "placement": {"xyz": [0.45, 0.0, -0.2]}}
+    problem = problem_from_config(parse_config(cfg))
+    from designopt.evaluation import evaluate
+
+    guess = initial_guesses(problem, 1, 0, 0.3, "ik")[0]
+    m = evaluate(problem, guess.q_d, guess.Q)
+    assert m.max_position_error < 1e-6 and m.max_axis_error < 1e-6
+    assert m.max_joint_step < 0.5  # one branch, no jumps
+
+
+def test_a_failed_solve_is_a_result_not_an_exception(gantry_problem):
+    nlp = Collocation(max_iter=2).build(gantry_problem)
+    raw = nlp.solve(initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0])
+    assert not raw.success
+    assert raw.status == "Maximum_Iterations_Exceeded"
