@@ -121,7 +121,8 @@ class CostsConfig(_Strict):
     tracking_weight: Positive = 1.0e4
     regularization: Annotated[float, Field(ge=0)] = 1.0e-3
     deflection: Literal["full", "translational"] = "full"
-    smoothness: Annotated[float, Field(ge=0)] = 1.0e-6
+    smoothness: Annotated[float, Field(ge=0)] = 1.0e-9
+    joint_regularization: Annotated[float, Field(ge=0)] = 1.0e-7
 
 
 class ToleranceConfig(_Strict):

@@ -32,7 +32,8 @@ class DesignProblem:
     deflection: str = "full"
     tracking_weight: float = 1.0e4
     regularization: float = 1.0e-3
-    smoothness: float = 1.0e-6
+    smoothness: float = 1.0e-9
+    joint_regularization: float = 1.0e-7
     joint_velocity: float = 10.0
     keep_out_radius: float = 0.0
     position_tol: float = 1.0e-3
@@ -99,6 +100,7 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         tracking_weight=cfg.costs.tracking_weight,
         regularization=cfg.costs.regularization,
         smoothness=cfg.costs.smoothness,
+        joint_regularization=cfg.costs.joint_regularization,
         joint_velocity=cfg.robot.joint_velocity,
         keep_out_radius=cfg.placement.keep_out_radius,
         position_tol=cfg.tolerance.position,

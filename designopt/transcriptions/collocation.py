@@ -21,11 +21,16 @@ import casadi as ca
 import numpy as np
 
 from designopt.problem import DesignProblem
-from designopt.transcriptions.base import InitialGuess, RawResult, ipopt_options, waypoint_function
+from designopt.transcriptions.base import InitialGuess, RawResult, waypoint_function
 from designopt.transcriptions.compiled import COMPILE_MODES
-from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
-
-Z_DOWN = np.array([0.0, 0.0, -1.0])
+from designopt.transcriptions.nlp import (
+    BlockStructure,
+    ConstraintList,
+    WaypointNLP,
+    joint_regularization,
+    waypoint_terms,
+    y_indices,
+)
 
 
 def hermite_midpoint(q0, v0, q1, v1, h):
@@ -40,39 +45,6 @@ def hermite_acceleration_integral(q0, v0, q1, v1, h):
     a0 = 6.0 * (q1 - q0) / h**2 - (4.0 * v0 + 2.0 * v1) / h
     a1 = -6.0 * (q1 - q0) / h**2 + (2.0 * v0 + 4.0 * v1) / h
     return h / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)
-
-
-def waypoint_terms(problem: DesignProblem, tracking: str, position_in_terms: bool):
-    """Cost phi_k and constraints c_k at one waypoint as a function of y_k = (q_k, q_d).
-
-    Returns the CasADi function (y, s_W, f_W) -> (phi, c) and the bounds of c. The tracking position
-    enters here only when p = FK(q) (forward kinematics); in differential mode it is the state p.
-    """
-    chain, tp = problem.chain, problem.toolpath
-    n_m, n_d, h = chain.n_moving, chain.n_design, tp.dt
-    y = ca.SX.sym("y", n_m + n_d)
-    s_W, f_W = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3)
-    p_W, z_W, L_d, rho2, _ = waypoint_function(problem)(y[:n_m], y[n_m:], s_W, f_W)
-    phi = h * L_d
-    c, lo, hi = [], [], []
-    if tracking == "soft":
-        L_t = ca.sumsqr(z_W - ca.DM(Z_DOWN)) + (ca.sumsqr(p_W - s_W) if position_in_terms else 0)
-        phi += h * problem.tracking_weight * L_t
-    else:
-        if position_in_terms:
-            c.append(p_W - s_W)
-            lo += [0.0] * 3
-            hi += [0.0] * 3
-        c.append(z_W)  # (0, 0, <= 0): the axis points into the surface; the sign excludes z = -z*
-        lo += [0.0, 0.0, -np.inf]
-        hi += [0.0, 0.0, 0.0]
-    if problem.keep_out_radius > 0:
-        c.append(rho2)
-        lo.append(problem.keep_out_radius**2)
-        hi.append(np.inf)
-    fn = ca.Function("terms", [y, s_W, f_W], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
-                     ["y", "s_W", "f_W"], ["phi", "c"])
-    return fn, np.array(lo), np.array(hi)
 
 
 @dataclass(frozen=True)
@@ -126,34 +98,24 @@ class CollocationNLP:
         x = ca.vertcat(q_d, ca.vec(Z))
         Q, V = Z[:n_m, :], Z[n_m : 2 * n_m, :]
         S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
-        Y = ca.vertcat(Q, ca.repmat(q_d, 1, N))
 
         terms, c_lo, c_hi = waypoint_terms(problem, scheme.tracking, position_in_terms=not differential)
-        Phi, C = terms.map(N)(Y, S, F)
+        Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F)
 
         Q0, V0, Q1, V1 = Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:]
         Q_mid, V_mid = hermite_midpoint(Q0, V0, Q1, V1, h)
         quadratic = 0
         if problem.regularized:
             quadratic += problem.regularization * ca.sumsqr(q_d[problem.regularized])
-        if problem.smoothness > 0:
-            # Squared acceleration, plus the same weight on h |q_k|^2: a constant joint offset (e.g. q_1
-            # against the placement yaw) is otherwise an exact null direction that stalls IPOPT.
-            quadratic += problem.smoothness * (
-                ca.sum1(ca.sum2(hermite_acceleration_integral(Q0, V0, Q1, V1, h))) + h * ca.sumsqr(Q)
-            )
+        # The smoothness term must stay small against the design cost: the figure-eight needs joint
+        # accelerations of ~100 rad per unit task time squared, so 1e-6 already outweighed L_d (measured).
+        accel = ca.sum1(ca.sum2(hermite_acceleration_integral(Q0, V0, Q1, V1, h)))
+        quadratic += problem.smoothness * accel + joint_regularization(problem, Q, h)
         objective = ca.sum2(Phi) + quadratic
 
-        g, lbg, ubg = [], [], []
-
-        def add(expr, lo, hi):
-            expr = ca.vec(expr)  # column-major, like the bounds
-            g.append(expr)
-            lbg.append(np.broadcast_to(np.ravel(lo, order="F"), expr.shape[0]))
-            ubg.append(np.broadcast_to(np.ravel(hi, order="F"), expr.shape[0]))
-
+        cons = ConstraintList()
         n_c = C.shape[0]
-        add(C, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)))  # first: multipliers 0..n_c N
+        cons.add(C, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)))  # multipliers 0 .. n_c N
 
         if differential:
             P = Z[2 * n_m :, :]
@@ -161,10 +123,10 @@ class CollocationNLP:
             p_W, _, _, _, Jv = wp.map(N)(Q, ca.repmat(q_d, 1, N), S, F)
             _, _, _, _, Jv_mid = wp.map(N - 1)(Q_mid, ca.repmat(q_d, 1, N - 1), S[:, :-1], F[:, :-1])
             pdot, pdot_mid = _pdot(Jv, V, n_m, N), _pdot(Jv_mid, V_mid, n_m, N - 1)
-            add(P[:, 0] - p_W[:, 0], 0.0, 0.0)
-            add(P[:, 1:] - P[:, :-1] - h / 6.0 * (pdot[:, :-1] + 4 * pdot_mid + pdot[:, 1:]), 0.0, 0.0)
+            cons.add(P[:, 0] - p_W[:, 0], 0.0, 0.0)
+            cons.add(P[:, 1:] - P[:, :-1] - h / 6.0 * (pdot[:, :-1] + 4 * pdot_mid + pdot[:, 1:]), 0.0, 0.0)
             if scheme.tracking == "hard":
-                add(P - S, 0.0, 0.0)
+                cons.add(P - S, 0.0, 0.0)
             else:
                 objective += h * problem.tracking_weight * ca.sumsqr(P - S)
             self._drift = ca.Function("drift", [x], [ca.mmax(ca.sqrt(ca.sum1((P - p_W) ** 2)))])
@@ -172,31 +134,23 @@ class CollocationNLP:
         lo_m = np.array([j.lower for j in chain.moving])
         hi_m = np.array([j.upper for j in chain.moving])
         vmax = problem.joint_velocity
-        add(Q_mid, np.tile(lo_m[:, None], (1, N - 1)), np.tile(hi_m[:, None], (1, N - 1)))
-        add(V_mid, -vmax, vmax)
+        cons.add(Q_mid, np.tile(lo_m[:, None], (1, N - 1)), np.tile(hi_m[:, None], (1, N - 1)))
+        cons.add(V_mid, -vmax, vmax)
 
         n_free = self.n_state - 2 * n_m
         state_lo = np.concatenate([lo_m, -vmax * np.ones(n_m), -np.inf * np.ones(n_free)])
         state_hi = np.concatenate([hi_m, vmax * np.ones(n_m), np.inf * np.ones(n_free)])
-        self.lbx = np.concatenate([[j.lower for j in chain.design], np.tile(state_lo, N)])
-        self.ubx = np.concatenate([[j.upper for j in chain.design], np.tile(state_hi, N)])
-        self.lbg, self.ubg = np.concatenate(lbg), np.concatenate(ubg)
-        g = ca.vertcat(*g)
-        self.n_variables, self.n_constraints = x.shape[0], g.shape[0]
-
-        opts = ipopt_options(scheme.max_iter, scheme.ipopt)
+        lbx = np.concatenate([[j.lower for j in chain.design], np.tile(state_lo, N)])
+        ubx = np.concatenate([[j.upper for j in chain.design], np.tile(state_hi, N)])
+        blocks = None
         if scheme.hessian == "structured" and not differential:
-            constant = np.array(ca.evalf(ca.hessian(quadratic, x)[0])) if problem.regularized or \
-                problem.smoothness > 0 else np.zeros((x.shape[0], x.shape[0]))
-            block = block_hessian_function(terms, n_m + n_d, n_c, scheme.compile)
-            q_index = n_d + np.arange(N)[:, None] * self.n_state + np.arange(n_m)[None, :]
-            y_index = np.hstack([q_index, np.tile(np.arange(n_d), (N, 1))])
-            mu_index = np.arange(N * n_c).reshape(N, n_c)
-            opts["hess_lag"] = assemble_hessian(
-                self.n_variables, self.n_constraints, block, y_index, lambda _x: [S, F], mu_index, constant
-            )
-        self.solver = ca.nlpsol("to", "ipopt", {"x": x, "f": objective, "g": g}, opts)
-        self.build_time_s = time.perf_counter() - t0
+            blocks = BlockStructure(terms, y_indices(n_d, n_m, N, self.n_state), np.arange(N * n_c).reshape(N, n_c),
+                                    scheme.compile)
+        self.nlp = WaypointNLP(problem, "to", x, objective, quadratic, cons, lbx, ubx, blocks, scheme.max_iter,
+                               scheme.ipopt, t0)
+        self.solver, self.lbx, self.ubx = self.nlp.solver, self.nlp.lbx, self.nlp.ubx
+        self.n_variables, self.n_constraints = self.nlp.n_variables, self.nlp.n_constraints
+        self.build_time_s = self.nlp.build_time_s
 
     def _pack(self, guess: InitialGuess) -> np.ndarray:
         p = self.problem
@@ -211,30 +165,11 @@ class CollocationNLP:
 
     def solve(self, guess: InitialGuess) -> RawResult:
         """Run IPOPT from one guess. A failed solve is a result with its status, not an exception."""
-        x0 = np.clip(self._pack(guess), self.lbx, self.ubx)
-        t0 = time.perf_counter()
-        sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
-        wall = time.perf_counter() - t0
-        stats = self.solver.stats()
-        x = np.asarray(sol["x"]).ravel()
+        x, objective, stats, wall = self.nlp.run(self._pack(guess))
         n_d, n_m, N = self.problem.chain.n_design, self.problem.chain.n_moving, self.problem.toolpath.n
         Z = x[n_d:].reshape(N, self.n_state)
         drift = float(self._drift(x)) if self.scheme.kinematics == "differential" else 0.0
-        return RawResult(
-            q_d=x[:n_d],
-            Q=Z[:, :n_m],
-            V=Z[:, n_m : 2 * n_m],
-            status=str(stats.get("return_status", "unknown")),
-            success=bool(stats.get("success", False)),
-            iterations=int(stats.get("iter_count", -1)),
-            solve_time_s=wall,
-            build_time_s=self.build_time_s,
-            objective=float(sol["f"]),
-            n_variables=self.n_variables,
-            n_constraints=self.n_constraints,
-            seed=guess.seed,
-            kinematic_drift=drift,
-        )
+        return self.nlp.result(x[:n_d], Z[:, :n_m], Z[:, n_m : 2 * n_m], objective, stats, wall, guess.seed, drift)
 
 
 def _pdot(Jv_W, V, n_m: int, n: int):

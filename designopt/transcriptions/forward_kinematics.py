@@ -1,0 +1,100 @@
+"""FK: the forward-kinematics baseline of Whitman et al. (SPEC §4).
+
+One independent joint vector q_k per waypoint plus the design joints; minimise the integrated deformation
+(+ regularisation) subject to L_t(t_k) <= epsilon at every waypoint. Nothing ties q_k to q_{k+1}, so a
+solution may jump between inverse-kinematics branches -- which no real trajectory can do; every result
+reports max_joint_step. ``continuous=True`` is the fair variant `fk_continuous`: |q_{k+1} - q_k| is bounded
+by the joint velocity limit TO uses, times the waypoint spacing.
+
+epsilon defaults to (0.95 position_tol)^2, so an FK solution tracks within the same tolerances as TO (its
+position error <= position_tol and axis error <= position_tol <= axis_tol).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from designopt.problem import DesignProblem
+from designopt.transcriptions.base import InitialGuess, RawResult
+from designopt.transcriptions.compiled import COMPILE_MODES
+from designopt.transcriptions.nlp import (
+    BlockStructure,
+    ConstraintList,
+    WaypointNLP,
+    joint_regularization,
+    waypoint_terms,
+    y_indices,
+)
+
+
+@dataclass(frozen=True)
+class ForwardKinematics:
+    """The FK baseline as a transcription of the same DesignProblem as TO."""
+
+    continuous: bool = False
+    epsilon: float | None = None
+    max_iter: int = 3000
+    compile: str = "O0"
+    ipopt: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.compile not in COMPILE_MODES:
+            raise ValueError(f"compile must be one of {COMPILE_MODES}, got {self.compile!r}")
+
+    @property
+    def name(self) -> str:
+        return "fk_continuous" if self.continuous else "fk"
+
+    def build(self, problem: DesignProblem) -> ForwardKinematicsNLP:
+        return ForwardKinematicsNLP(problem, self)
+
+
+class ForwardKinematicsNLP:
+    def __init__(self, problem: DesignProblem, scheme: ForwardKinematics):
+        t0 = time.perf_counter()
+        self.problem, self.scheme = problem, scheme
+        chain, tp = problem.chain, problem.toolpath
+        n_m, n_d, N, h = chain.n_moving, chain.n_design, tp.n, tp.dt
+        # (0.95 tol)^2: IPOPT accepts constraint violations of ~1e-8, which on L_t <= tol^2 alone would put
+        # the position error just above tol (measured 1.0045 mm for tol = 1 mm).
+        self.epsilon = scheme.epsilon if scheme.epsilon is not None else (0.95 * problem.position_tol) ** 2
+
+        q_d = ca.SX.sym("q_d", n_d)
+        Q = ca.SX.sym("Q", n_m, N)
+        x = ca.vertcat(q_d, ca.vec(Q))
+        S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
+        terms, c_lo, c_hi = waypoint_terms(problem, "epsilon", epsilon=self.epsilon)
+        Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F)
+        quadratic = joint_regularization(problem, Q, h)
+        if problem.regularized:
+            quadratic += problem.regularization * ca.sumsqr(q_d[problem.regularized])
+        objective = ca.sum2(Phi) + quadratic
+
+        cons = ConstraintList()
+        n_c = C.shape[0]
+        cons.add(C, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)))
+        if scheme.continuous:
+            step = problem.joint_velocity * h
+            cons.add(Q[:, 1:] - Q[:, :-1], -step, step)
+
+        lo_m = [j.lower for j in chain.moving]
+        hi_m = [j.upper for j in chain.moving]
+        lbx = np.concatenate([[j.lower for j in chain.design], np.tile(lo_m, N)])
+        ubx = np.concatenate([[j.upper for j in chain.design], np.tile(hi_m, N)])
+        blocks = BlockStructure(terms, y_indices(n_d, n_m, N, n_m), np.arange(N * n_c).reshape(N, n_c),
+                                scheme.compile)
+        self.nlp = WaypointNLP(problem, scheme.name, x, objective, quadratic, cons, lbx, ubx, blocks,
+                               scheme.max_iter, scheme.ipopt, t0)
+        self.n_variables, self.n_constraints = self.nlp.n_variables, self.nlp.n_constraints
+        self.build_time_s = self.nlp.build_time_s
+
+    def solve(self, guess: InitialGuess) -> RawResult:
+        """Run IPOPT from one guess (only q_d and Q are used: FK has no velocities)."""
+        x0 = np.concatenate([np.asarray(guess.q_d, float), np.asarray(guess.Q, float).ravel()])
+        x, objective, stats, wall = self.nlp.run(x0)
+        n_d, n_m, N = self.problem.chain.n_design, self.problem.chain.n_moving, self.problem.toolpath.n
+        return self.nlp.result(x[:n_d], x[n_d:].reshape(N, n_m), None, objective, stats, wall, guess.seed)

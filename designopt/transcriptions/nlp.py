@@ -1,0 +1,139 @@
+"""The part every transcription shares: per-waypoint terms in y_k = (q_k, q_d), an NLP with the exact
+structured Hessian, and a solve that turns IPOPT's answer into a RawResult.
+
+A transcription decides the decision vector layout, the objective and the constraints; `WaypointNLP`
+does the rest.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from designopt.problem import DesignProblem
+from designopt.transcriptions.base import RawResult, ipopt_options, waypoint_function
+from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
+
+Z_DOWN = np.array([0.0, 0.0, -1.0])
+
+
+@dataclass
+class ConstraintList:
+    """Constraints and their bounds, stacked in the order added (CasADi's column-major vec)."""
+
+    def __post_init__(self):
+        self.g, self.lo, self.hi = [], [], []
+
+    def add(self, expr, lo, hi) -> None:
+        expr = ca.vec(expr)
+        self.g.append(expr)
+        self.lo.append(np.broadcast_to(np.ravel(lo, order="F"), expr.shape[0]))
+        self.hi.append(np.broadcast_to(np.ravel(hi, order="F"), expr.shape[0]))
+
+    def stacked(self):
+        return ca.vertcat(*self.g), np.concatenate(self.lo), np.concatenate(self.hi)
+
+
+@dataclass(frozen=True)
+class BlockStructure:
+    """Where the per-waypoint terms sit: x indices of each y_k and lam_g indices of each c_k."""
+
+    terms: ca.Function
+    y_index: np.ndarray
+    mu_index: np.ndarray
+    compile: str
+
+
+class WaypointNLP:
+    """An IPOPT problem whose nonlinear terms are per-waypoint blocks (plus quadratic terms)."""
+
+    def __init__(self, problem: DesignProblem, name: str, x, objective, quadratic, constraints: ConstraintList,
+                 lbx, ubx, blocks: BlockStructure | None, max_iter: int, ipopt: dict | None, t_start: float):
+        self.problem = problem
+        g, self.lbg, self.ubg = constraints.stacked()
+        self.lbx, self.ubx = np.asarray(lbx, float), np.asarray(ubx, float)
+        self.n_variables, self.n_constraints = x.shape[0], g.shape[0]
+        opts = ipopt_options(max_iter, ipopt)
+        if blocks is not None:
+            n_y, n_c = blocks.y_index.shape[1], blocks.mu_index.shape[1]
+            tp = problem.toolpath
+            constant = np.array(ca.evalf(ca.hessian(quadratic, x)[0])) if not isinstance(quadratic, (int, float)) \
+                else np.zeros((x.shape[0], x.shape[0]))
+            block = block_hessian_function(blocks.terms, n_y, n_c, blocks.compile)
+            S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
+            opts["hess_lag"] = assemble_hessian(self.n_variables, self.n_constraints, block, blocks.y_index,
+                                                lambda _x: [S, F], blocks.mu_index, constant)
+        self.solver = ca.nlpsol(name, "ipopt", {"x": x, "f": objective, "g": g}, opts)
+        self.build_time_s = time.perf_counter() - t_start
+
+    def run(self, x0: np.ndarray):
+        """Solve from x0; returns (x, objective, stats, wall time)."""
+        x0 = np.clip(x0, self.lbx, self.ubx)
+        t0 = time.perf_counter()
+        sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        wall = time.perf_counter() - t0
+        return np.asarray(sol["x"]).ravel(), float(sol["f"]), self.solver.stats(), wall
+
+    def result(self, q_d, Q, V, objective, stats, wall, seed, drift=0.0) -> RawResult:
+        return RawResult(
+            q_d=q_d, Q=Q, V=V,
+            status=str(stats.get("return_status", "unknown")),
+            success=bool(stats.get("success", False)),
+            iterations=int(stats.get("iter_count", -1)),
+            solve_time_s=wall, build_time_s=self.build_time_s, objective=objective,
+            n_variables=self.n_variables, n_constraints=self.n_constraints, seed=seed, kinematic_drift=drift,
+        )
+
+
+def y_indices(n_d: int, n_m: int, N: int, stride: int) -> np.ndarray:
+    """x-indices of y_k = (q_k, q_d) when x = (q_d, z_0, ..., z_{N-1}) with q_k first in each z_k."""
+    q_index = n_d + np.arange(N)[:, None] * stride + np.arange(n_m)[None, :]
+    return np.hstack([q_index, np.tile(np.arange(n_d), (N, 1))])
+
+
+def joint_regularization(problem: DesignProblem, Q, h: float):
+    """h * weight * sum |q_k|^2: removes exact null directions (a constant joint offset against the
+    placement yaw; rotation about the tool axis) that otherwise stall IPOPT. Weight: costs.joint_regularization,
+    small enough to stay well below 1 % of the design cost on the default problem."""
+    return problem.joint_regularization * h * ca.sumsqr(Q)
+
+
+def waypoint_terms(problem: DesignProblem, tracking: str, position_in_terms: bool = True, epsilon: float = 0.0):
+    """Cost phi_k and constraints c_k at one waypoint as a function of y_k = (q_k, q_d).
+
+    Returns the CasADi function (y, s_W, f_W) -> (phi, c) and the bounds of c. ``tracking`` is ``hard``
+    (position and axis equalities), ``soft`` (w L_t in phi) or ``epsilon`` (L_t <= epsilon, the FK
+    baseline). The position enters only when p = FK(q); in differential mode it is a state.
+    """
+    chain, tp = problem.chain, problem.toolpath
+    n_m, n_d, h = chain.n_moving, chain.n_design, tp.dt
+    y = ca.SX.sym("y", n_m + n_d)
+    s_W, f_W = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3)
+    p_W, z_W, L_d, rho2, _ = waypoint_function(problem)(y[:n_m], y[n_m:], s_W, f_W)
+    phi = h * L_d
+    c, lo, hi = [], [], []
+    if tracking == "epsilon":
+        c.append(ca.sumsqr(p_W - s_W) + ca.sumsqr(z_W - ca.DM(Z_DOWN)))
+        lo.append(-np.inf)
+        hi.append(epsilon)
+    elif tracking == "soft":
+        L_t = ca.sumsqr(z_W - ca.DM(Z_DOWN)) + (ca.sumsqr(p_W - s_W) if position_in_terms else 0)
+        phi += h * problem.tracking_weight * L_t
+    else:
+        if position_in_terms:
+            c.append(p_W - s_W)
+            lo += [0.0] * 3
+            hi += [0.0] * 3
+        c.append(z_W)  # (0, 0, <= 0): the axis points into the surface; the sign excludes z = -z*
+        lo += [0.0, 0.0, -np.inf]
+        hi += [0.0, 0.0, 0.0]
+    if problem.keep_out_radius > 0:
+        c.append(rho2)
+        lo.append(problem.keep_out_radius**2)
+        hi.append(np.inf)
+    fn = ca.Function("terms", [y, s_W, f_W], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
+                     ["y", "s_W", "f_W"], ["phi", "c"])
+    return fn, np.array(lo), np.array(hi)
