@@ -23,6 +23,11 @@ test: setup
 lint: setup
 	$(BIN)/ruff check .
 
+# Every figure and table of the paper's results section, into results/ (see docs/results.md).
+figures: setup
+	$(BIN)/designopt continuous configs/continuous.yaml --name paper
+	$(BIN)/designopt waypoints configs/continuous.yaml --name paper
+
 benchmark: setup
 	$(BIN)/python benchmarks/bench_solve.py
 

@@ -79,6 +79,80 @@ def run(
     out.print(f"results: {result.directory.path}")
 
 
+def _progress():
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    return Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                    TextColumn("eta"), TimeRemainingColumn(), console=err, transient=True)
+
+
+def _frame_table(frame, title: str) -> Table:
+    table = Table(title=title)
+    for col in frame.columns:
+        table.add_column(str(col), justify="right")
+    for _, row in frame.iterrows():
+        table.add_row(*[f"{v:.4g}" if isinstance(v, float) else str(v) for v in row])
+    return table
+
+
+ConfigArg = Annotated[Path, typer.Argument(help="YAML config.")]
+OutOpt = Annotated[Path, typer.Option("--out", help="Root of the results tree.")]
+NameOpt = Annotated[str | None, typer.Option("--name", help="Run name (default: a timestamp).")]
+
+
+@app.command()
+def continuous(
+    config: ConfigArg = Path("configs/continuous.yaml"),
+    out_dir: OutOpt = Path("results"),
+    name: NameOpt = None,
+):
+    """Continuous design problem: placement only, design only, combined x TO, FK, FK with bounded steps."""
+    from designopt.experiments.continuous import run_continuous
+
+    cfg = load(config)
+    total = len(cfg.continuous.cases) * len(cfg.continuous.methods) * cfg.solver.multistart
+    failed = 0
+    with _progress() as progress:
+        task = progress.add_task("continuous: solving", total=total)
+
+        def done(case, sol):
+            nonlocal failed
+            failed += not sol.metrics.tracks
+            progress.update(task, advance=1, description=f"continuous: {failed} not tracking")
+
+        result = run_continuous(cfg, config.parent, out_dir, name, on_solution=done)
+    cols = ["case", "method", "n_design_joints", "design_cost", "max_joint_step", "tracking_starts", "starts",
+            "median_solve_time_s"]
+    out.print(_frame_table(result.table[cols], "best tracking start per case and method"))
+    out.print(f"results: {result.directory.path}")
+
+
+@app.command()
+def waypoints(
+    config: ConfigArg = Path("configs/continuous.yaml"),
+    out_dir: OutOpt = Path("results"),
+    name: NameOpt = None,
+):
+    """Waypoint study: design cost, tracking between waypoints and solve time against N (TO, combined)."""
+    from designopt.experiments.waypoints import run_waypoint_study
+
+    cfg = load(config)
+    total = len(cfg.continuous.waypoint_study) * cfg.solver.multistart
+    with _progress() as progress:
+        task = progress.add_task("waypoint study", total=total)
+        table = run_waypoint_study(cfg, config.parent, out_dir, name,
+                                   on_solution=lambda n, _s: progress.update(task, advance=1,
+                                                                             description=f"waypoint study N={n}"))
+    out.print(_frame_table(table, "waypoint study (TO, design + placement)"))
+
+
 def main() -> None:
     try:
         app()

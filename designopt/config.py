@@ -144,6 +144,18 @@ class SolverConfig(_Strict):
     time_limit: Positive = 300.0
 
 
+Method = Literal["to", "fk", "fk_continuous"]
+Case = Literal["placement_only", "design_only", "combined"]
+
+
+class ContinuousConfig(_Strict):
+    """The continuous-design comparison (SPEC §5): which cases and methods, and the waypoint study."""
+
+    cases: list[Case] = ["placement_only", "design_only", "combined"]
+    methods: list[Method] = ["to", "fk", "fk_continuous"]
+    waypoint_study: list[Annotated[int, Field(ge=3, le=2000)]] = [20, 40, 80, 160, 320]
+
+
 class Config(_Strict):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]+$")] = "run"
     toolpath: ToolpathConfig = FigureEight(kind="figure_eight")
@@ -152,6 +164,7 @@ class Config(_Strict):
     costs: CostsConfig = CostsConfig()
     tolerance: ToleranceConfig = ToleranceConfig()
     solver: SolverConfig = SolverConfig()
+    continuous: ContinuousConfig = ContinuousConfig()
 
 
 def _key(loc: tuple) -> str:

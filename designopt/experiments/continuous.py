@@ -1,0 +1,147 @@
+"""The continuous design problem (SPEC §5-6, claims C1-C3): three cases, three methods, multistart.
+
+Cases differ only in which joints are design joints -- one mechanism:
+  placement_only  the configured robot (PUMA-560) is fixed; the 6 placement joints are free
+  design_only     the workpiece is fixed at placement.xyz/ypr; d, a, alpha of every link are free (18)
+  combined        both (24)
+Methods: ``to`` (collocation), ``fk`` (Whitman et al.), ``fk_continuous`` (FK with bounded joint steps).
+Every (case, method, start) is one joblib task; each finished solve is written at once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from designopt.config import Config, dump_config
+from designopt.experiments.run import multistart_from_config, record
+from designopt.multistart import Multistart, best_solution, solve_start
+from designopt.problem import DesignProblem, problem_from_config
+from designopt.results_io import RunDirectory
+from designopt.solution import Solution, write_solution
+from designopt.transcriptions import transcription_named
+
+CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
+
+
+def case_config(cfg: Config, case: str) -> Config:
+    """The config of one case: the same robot and cell with other joints marked as design joints."""
+    robot, placement = cfg.robot, cfg.placement
+    design = robot.design or ["d", "a", "alpha"]
+    if case == "placement_only":
+        robot, placement = robot.model_copy(update={"design": []}), placement.model_copy(update={"optimize": True})
+    elif case == "design_only":
+        robot, placement = robot.model_copy(update={"design": design}), placement.model_copy(update={"optimize": False})
+    elif case == "combined":
+        robot, placement = robot.model_copy(update={"design": design}), placement.model_copy(update={"optimize": True})
+    else:
+        raise ValueError(f"unknown case {case!r}")
+    return cfg.model_copy(update={"robot": robot, "placement": placement})
+
+
+def method_transcription(cfg: Config, method: str):
+    s = cfg.solver
+    options = {"max_iter": s.max_iter, "ipopt": {"ipopt.max_wall_time": float(s.time_limit)}}
+    if method == "to":
+        options.update(kinematics=s.kinematics, tracking=s.tracking, degree=s.degree)
+    return transcription_named(method, **options)
+
+
+@dataclass(frozen=True)
+class Task:
+    case: str
+    method: str
+    problem: DesignProblem
+    transcription: object
+    settings: Multistart
+    index: int
+
+
+def _solve(task: Task) -> tuple[str, Solution]:
+    return task.case, solve_start(task.problem, task.transcription, task.settings, task.index, task.case)
+
+
+def run_tasks(tasks: list[Task], jobs: int):
+    """Yield (case, solution) as tasks finish, in parallel when jobs != 1."""
+    if jobs == 1:
+        for t in tasks:
+            yield _solve(t)
+        return
+    from joblib import Parallel, delayed
+
+    yield from Parallel(n_jobs=jobs, return_as="generator_unordered")(delayed(_solve)(t) for t in tasks)
+
+
+@dataclass(frozen=True)
+class ContinuousResult:
+    directory: RunDirectory
+    summary: pd.DataFrame
+    table: pd.DataFrame
+    best: dict  # (case, method) -> Solution | None
+
+
+def best_table(solutions: dict) -> pd.DataFrame:
+    """One row per (case, method): the best tracking start and how many starts tracked."""
+    rows = []
+    for (case, method), sols in solutions.items():
+        best = best_solution(sols)
+        tracking = [s for s in sols if s.metrics.tracks]
+        rows.append({
+            "case": case, "method": method, "n_design_joints": sols[0].problem.chain.n_design,
+            "design_cost": best.metrics.design_cost if best else float("nan"),
+            "max_joint_step": best.metrics.max_joint_step if best else float("nan"),
+            "max_position_error": best.metrics.max_position_error if best else float("nan"),
+            "starts": len(sols), "tracking_starts": len(tracking),
+            "median_cost_tracking": pd.Series([s.metrics.design_cost for s in tracking]).median(),
+            "median_solve_time_s": pd.Series([s.raw.solve_time_s for s in sols]).median(),
+            "median_iterations": pd.Series([s.raw.iterations for s in sols]).median(),
+            "best_seed": best.raw.seed if best else None,
+        })
+    order = {c: i for i, c in enumerate(CASE_LABELS)}
+    return pd.DataFrame(rows).sort_values(["case", "method"], key=lambda c: c.map(order) if c.name == "case" else c)
+
+
+def run_continuous(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
+                   on_solution: Callable[[str, Solution], None] | None = None, figures: bool = True,
+                   experiment: str = "continuous") -> ContinuousResult:
+    run = RunDirectory.create(out_root, experiment, run_name)
+    run.write_config(dump_config(cfg))
+    settings = multistart_from_config(cfg)
+    tasks = []
+    for case in cfg.continuous.cases:
+        problem = problem_from_config(case_config(cfg, case), base_dir)
+        for method in cfg.continuous.methods:
+            transcription = method_transcription(cfg, method)
+            tasks += [Task(case, method, problem, transcription, settings, i) for i in range(settings.count)]
+    run.log(f"start continuous: {len(tasks)} solves ({len(cfg.continuous.cases)} cases x "
+            f"{len(cfg.continuous.methods)} methods x {settings.count} starts)")
+    jobs = settings.jobs if settings.jobs != -1 else -1
+    solutions: dict = {}
+    for case, sol in run_tasks(tasks, jobs):
+        record(run, sol, experiment, case)
+        solutions.setdefault((case, sol.method), []).append(sol)
+        if on_solution:
+            on_solution(case, sol)
+    best = {key: best_solution(sols) for key, sols in solutions.items()}
+    summary = pd.read_csv(run.summary)
+    best_files = {f"solutions/{k[0]}-{s.method}-{s.problem.chain.structure}-s{s.raw.seed}.json"
+                  for k, s in best.items() if s is not None}
+    summary["best"] = summary["solution_file"].isin(best_files)
+    summary.to_csv(run.summary, index=False)
+    table = best_table(solutions)
+    table.to_csv(run.path / "table.csv", index=False)
+    for (case, method), sol in best.items():
+        if sol is not None:
+            write_solution(sol, run.path / f"best-{case}-{method}.json")
+    if figures:
+        from designopt import plots_experiments
+
+        plots_experiments.design_cost_figure(table, summary, run.figures)
+        robots = {c: best.get((c, "to")) for c in ("design_only", "combined") if best.get((c, "to"))}
+        if robots:
+            plots_experiments.optimal_robots_figure(robots, run.figures)
+    run.log("done")
+    return ContinuousResult(run, summary, table, best)

@@ -1,0 +1,48 @@
+"""The continuous experiment end to end on a small problem: 9 rows, both figures, files re-verify."""
+
+from __future__ import annotations
+
+import pandas as pd
+import yaml
+from typer.testing import CliRunner
+
+from cli.main import app
+from designopt.config import parse_config
+from designopt.experiments.continuous import case_config
+from designopt.verify import verify_file
+
+
+def test_cases_differ_only_in_roles():
+    cfg = parse_config({})
+    placement, design, combined = (case_config(cfg, c) for c in ("placement_only", "design_only", "combined"))
+    assert placement.robot.design == [] and placement.placement.optimize is True
+    assert design.robot.design == ["d", "a", "alpha"] and design.placement.optimize is False
+    assert combined.robot.design == ["d", "a", "alpha"] and combined.placement.optimize is True
+    assert placement.toolpath == design.toolpath == combined.toolpath
+
+
+def test_continuous_experiment_small(tmp_path):
+    config = tmp_path / "c.yaml"
+    config.write_text(yaml.safe_dump({
+        "name": "continuous",
+        "toolpath": {"kind": "figure_eight", "width": 0.6, "height": 0.3, "waypoints": 10},
+        "placement": {"xyz": [0.45, 0.0, -0.2]},
+        "solver": {"multistart": 1, "max_iter": 300, "jobs": 2},
+    }))
+    result = CliRunner().invoke(app, ["continuous", str(config), "--out", str(tmp_path / "r"), "--name", "t"])
+    assert result.exit_code == 0, result.output
+    run = tmp_path / "r" / "continuous" / "t"
+    summary = pd.read_csv(run / "summary.csv")
+    assert len(summary) == 9
+    assert set(zip(summary["case"], summary["method"], strict=True)) == {
+        (c, m) for c in ("placement_only", "design_only", "combined") for m in ("to", "fk", "fk_continuous")}
+    assert set(summary.groupby("case")["n_design_joints"].first()) == {6, 18, 24}
+    for stem in ("design_cost", "optimal_robots"):
+        assert (run / "figures" / f"{stem}.png").stat().st_size > 1000
+    table = pd.read_csv(run / "table.csv")
+    assert len(table) == 9
+    for f in (run / "solutions").glob("*.json"):
+        assert verify_file(f) == [], f
+    # max_joint_step of fk_continuous never exceeds its bound vmax * dt
+    bound = 10.0 / 9
+    assert (summary.loc[summary["method"] == "fk_continuous", "max_joint_step"] <= bound * (1 + 1e-6)).all()
