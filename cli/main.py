@@ -55,6 +55,7 @@ def run(
     out_dir: Annotated[Path, typer.Option("--out", help="Root of the results tree.")] = Path("results"),
     name: Annotated[str | None, typer.Option("--name", help="Run name (default: a timestamp).")] = None,
     no_figures: Annotated[bool, typer.Option("--no-figures", help="Skip the figures.")] = False,
+    urdf: Annotated[bool, typer.Option("--urdf", help="Also export the best design as URDF (see export).")] = False,
 ):
     """Solve one design problem (multistart TO) and write results/<experiment>/<run>/."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -76,6 +77,12 @@ def run(
         placement = b.chain.placement_values([0.0] * b.chain.n_moving, [])
         out.print(f"best: seed {b.raw.seed}, design cost [bold]{b.metrics.design_cost:.6g}[/bold], "
                   f"placement xyz = ({placement[0]:.3f}, {placement[1]:.3f}, {placement[2]:.3f}) m")
+        if urdf:
+            from designopt.export import export as export_cell
+            from designopt.solution import to_dict
+
+            for p in export_cell(to_dict(b), result.directory.path / "export", stem="best"):
+                out.print(f"wrote {p}")
     out.print(f"results: {result.directory.path}")
 
 
@@ -151,6 +158,53 @@ def waypoints(
                                    on_solution=lambda n, _s: progress.update(task, advance=1,
                                                                              description=f"waypoint study N={n}"))
     out.print(_frame_table(table, "waypoint study (TO, design + placement)"))
+
+
+def _read_solution(path: Path) -> dict:
+    import json
+
+    try:
+        data = json.loads(path.read_text())
+    except FileNotFoundError:
+        fail(f"{path}: (file): no such file")
+    except (OSError, json.JSONDecodeError) as exc:
+        fail(f"{path}: (file): not a JSON solution file ({exc})")
+    if data.get("schema") != "designopt.solution/1":
+        fail(f"{path}: schema: expected 'designopt.solution/1', got {data.get('schema')!r}")
+    return data
+
+
+@app.command()
+def export(
+    solution: Annotated[Path, typer.Argument(help="A solution file (designopt.solution/1).")],
+    out_dir: Annotated[Path | None, typer.Option("--out", help="Directory (default: next to the solution).")] = None,
+):
+    """Write the designed cell as URDF (robot + placed workpiece + toolpath) and the joint trajectory."""
+    from designopt.export import export as export_cell
+
+    data = _read_solution(solution)
+    paths = export_cell(data, out_dir or solution.parent / "export", stem=solution.stem)
+    for p in paths:
+        out.print(f"wrote {p}")
+
+
+@app.command()
+def render(
+    solution: Annotated[Path, typer.Argument(help="A solution file (designopt.solution/1).")],
+    out_dir: Annotated[Path | None, typer.Option("--out", help="Directory (default: next to the solution).")] = None,
+    frames: Annotated[int, typer.Option(min=1, max=50, help="Robot poses drawn along the path.")] = 6,
+    animate: Annotated[bool, typer.Option("--animate", help="Also write an animation (GIF, or MP4 with ffmpeg).")]
+    = False,
+):
+    """Draw the robot following its path (PNG + PDF), optionally animated."""
+    from designopt.plots import render_animation, render_figure, save
+
+    data = _read_solution(solution)
+    target = out_dir or solution.parent
+    for p in save(render_figure(data, frames), target, f"{solution.stem}_render"):
+        out.print(f"wrote {p}")
+    if animate:
+        out.print(f"wrote {render_animation(data, target / f'{solution.stem}_render.gif')}")
 
 
 def main() -> None:

@@ -33,20 +33,20 @@ def _equal_3d(ax, points: np.ndarray) -> None:
     ax.set_box_aspect((1, 1, 1))
 
 
-def draw_robot(ax, sol: Solution, q: np.ndarray, color: str = "C0", path: bool = True) -> np.ndarray:
-    """Draw the chain at joint values q (a polyline through the DH frame origins), the base and the
-    placed toolpath, in the base frame B. Returns the points drawn (for axis limits)."""
-    chain = sol.chain
+def draw_robot(ax, chain, q: np.ndarray, points_W: np.ndarray | None = None, color: str = "C0",
+               label: str | None = None) -> np.ndarray:
+    """Draw a solved chain at joint values q (a polyline through the DH frame origins), its base and,
+    if given, the toolpath placed in B. Returns the points drawn (for axis limits)."""
     frames = link_frames(chain, q, np.zeros(0))
     tool = tool_pose(chain, q, np.zeros(0))
     origins = np.array([T[:3, 3] for T in frames] + [tool[:3, 3]])
-    ax.plot(*origins.T, "-o", color=color, lw=3, ms=4, label=f"{chain.structure} robot")
-    ax.scatter(0, 0, 0, marker="s", s=60, color="k", label="base B")
+    ax.plot(*origins.T, "-o", color=color, lw=3, ms=4, label=label or f"{chain.structure} robot")
+    ax.scatter(0, 0, 0, marker="s", s=60, color="k", label="base B" if label is None else None)
     drawn = [origins]
-    if path:
+    if points_W is not None:
         T_BW = placement_pose(chain, q, np.zeros(0))
-        s_B = (T_BW[:3, :3] @ sol.problem.toolpath.points_W.T).T + T_BW[:3, 3]
-        ax.plot(*s_B.T, "-", color="C3", lw=1.5, label="toolpath (placed)")
+        s_B = (T_BW[:3, :3] @ np.asarray(points_W).T).T + T_BW[:3, 3]
+        ax.plot(*s_B.T, "-", color="C3", lw=1.5, label="toolpath (placed)" if label is None else None)
         for axis, c in zip(range(3), ("r", "g", "b"), strict=True):
             end = T_BW[:3, 3] + 0.1 * T_BW[:3, axis]
             ax.plot(*np.c_[T_BW[:3, 3], end], color=c, lw=1)
@@ -54,14 +54,18 @@ def draw_robot(ax, sol: Solution, q: np.ndarray, color: str = "C0", path: bool =
     return np.vstack(drawn)
 
 
-def robot_figure(sol: Solution, title: str | None = None):
-    fig = plt.figure(figsize=(5.5, 5))
-    ax = fig.add_subplot(projection="3d")
-    pts = draw_robot(ax, sol, sol.raw.Q[0])
-    _equal_3d(ax, np.vstack([pts, np.zeros((1, 3))]))
+def _label_axes(ax) -> None:
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")
+
+
+def robot_figure(sol: Solution, title: str | None = None):
+    fig = plt.figure(figsize=(5.5, 5))
+    ax = fig.add_subplot(projection="3d")
+    pts = draw_robot(ax, sol.chain, sol.raw.Q[0], sol.problem.toolpath.points_W)
+    _equal_3d(ax, np.vstack([pts, np.zeros((1, 3))]))
+    _label_axes(ax)
     ax.set_title(title or f"{sol.problem.chain.structure}: design cost {sol.metrics.design_cost:.3g} (start pose)")
     ax.legend(loc="upper left", fontsize=7)
     return fig
@@ -107,3 +111,55 @@ def solution_figures(sol: Solution, directory: Path) -> list[Path]:
     out += save(joint_figure(sol), directory, "joints")
     out += save(deformation_figure(sol), directory, "deformation")
     return out
+
+
+def render_figure(data: dict, frames: int = 6):
+    """The robot of a solution file drawn at ``frames`` waypoints along its path (lighter = earlier)."""
+    from designopt.solution import chain_from_file
+
+    chain, Q, pts = chain_from_file(data), np.array(data["q"]), np.array(data["toolpath"]["points_W"])
+    picks = np.linspace(0, len(Q) - 1, frames).round().astype(int)
+    fig = plt.figure(figsize=(6, 5.5))
+    ax = fig.add_subplot(projection="3d")
+    cmap = plt.get_cmap("Blues")
+    drawn = []
+    for n, k in enumerate(picks):
+        drawn.append(draw_robot(ax, chain, Q[k], pts if n == 0 else None,
+                                color=cmap(0.35 + 0.65 * n / max(frames - 1, 1)),
+                                label=f"t = {data['toolpath']['t'][k]:.2f}"))
+    _equal_3d(ax, np.vstack(drawn + [np.zeros((1, 3))]))
+    _label_axes(ax)
+    ax.set_title(f"{data['structure']} ({data['method']}): design cost {data['metrics']['design_cost']:.3g}")
+    ax.legend(loc="upper left", fontsize=6)
+    return fig
+
+
+def render_animation(data: dict, path: Path, fps: int = 15) -> Path:
+    """An animation of the robot following its path (GIF through Pillow, or MP4 if ffmpeg is present)."""
+    from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
+
+    from designopt.solution import chain_from_file
+
+    chain, Q, pts = chain_from_file(data), np.array(data["q"]), np.array(data["toolpath"]["points_W"])
+    fig = plt.figure(figsize=(5, 5))
+    ax = fig.add_subplot(projection="3d")
+    limits = np.vstack([draw_robot(ax, chain, q, pts) for q in Q[:: max(1, len(Q) // 8)]] + [np.zeros((1, 3))])
+    T_BW = placement_pose(chain, Q[0], np.zeros(0))
+    s_B = (T_BW[:3, :3] @ pts.T).T + T_BW[:3, 3]
+
+    def frame(k):
+        ax.cla()
+        draw_robot(ax, chain, Q[k], pts)
+        ax.scatter(*s_B[k], color="C3", s=25)
+        _equal_3d(ax, limits)
+        _label_axes(ax)
+        ax.set_title(f"t = {data['toolpath']['t'][k]:.2f}")
+
+    anim = FuncAnimation(fig, frame, frames=len(Q))
+    if path.suffix == ".mp4" and FFMpegWriter.isAvailable():
+        anim.save(path, writer=FFMpegWriter(fps=fps))
+    else:
+        path = path.with_suffix(".gif")
+        anim.save(path, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    return path

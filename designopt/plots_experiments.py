@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from designopt.plots import _equal_3d, draw_robot, plt, save
+from designopt.plots import _equal_3d, _label_axes, draw_robot, plt, save
 
 METHOD_LABELS = {"to": "TO (collocation)", "fk": "FK (Whitman et al.)", "fk_continuous": "FK, bounded steps"}
 CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
@@ -47,11 +47,9 @@ def optimal_robots_figure(solutions: dict, directory: Path) -> list[Path]:
     fig = plt.figure(figsize=(4.5 * len(solutions), 4.5))
     for k, (case, sol) in enumerate(solutions.items()):
         ax = fig.add_subplot(1, len(solutions), k + 1, projection="3d")
-        pts = draw_robot(ax, sol, np.zeros(sol.problem.chain.n_moving))
+        pts = draw_robot(ax, sol.chain, np.zeros(sol.problem.chain.n_moving), sol.problem.toolpath.points_W)
         _equal_3d(ax, np.vstack([pts, np.zeros((1, 3))]))
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.set_zlabel("z [m]")
+        _label_axes(ax)
         ax.set_title(f"{CASE_LABELS.get(case, case)}\ndesign cost {sol.metrics.design_cost:.3g}", fontsize=9)
         if k == 0:
             ax.legend(loc="upper left", fontsize=6)

@@ -11,7 +11,7 @@ import json
 import math
 import os
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -104,6 +104,8 @@ def to_dict(sol: Solution) -> dict:
             "force_W": p.toolpath.force_W.tolist(),
         },
         "q": np.asarray(r.Q).tolist(),
+        "joint_limits": [{"name": j.name, "lower": j.lower, "upper": j.upper, "velocity_per_task_time":
+                          p.joint_velocity} for j in p.chain.moving],
         "design_joints": {j.name: float(v) for j, v in zip(p.chain.design, r.q_d, strict=True)},
         "metrics": {
             "design_cost": m.design_cost,
@@ -139,3 +141,12 @@ def write_json(data: dict, path: Path) -> None:
 def write_solution(sol: Solution, path: Path) -> None:
     write_json(to_dict(sol), path)
 
+
+
+def chain_from_file(data: dict) -> Chain:
+    """Rebuild the solved chain (every design joint fixed) from a designopt.solution/1 dict."""
+    from designopt.design_space import build_chain
+
+    rows = [{k: (0.0 if row[k] is None else row[k]) for k in DH_PARAMS} for row in data["dh"]]
+    chain = build_chain(data["structure"], rows, [], data["placement"]["xyz"], data["placement"]["ypr"], ())
+    return replace(chain, tool=tuple(tuple(float(v) for v in r) for r in data["tool"]))

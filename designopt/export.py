@@ -1,0 +1,114 @@
+"""Export a solved design as URDF (robot + workpiece cell) and its joint trajectory.
+
+Built with yourdfpy from the solution file alone (schema designopt.solution/1). Each DH link i becomes an
+actuated joint about/along z_{i-1} (revolute or prismatic) followed by a fixed joint carrying the rest of
+the DH transform:
+    R link: Rz(q) . [Tz(d) Tx(a) Rx(alpha)]          fixed origin xyz = (a, 0, d),            rpy = (alpha, 0, 0)
+    P link: Tz(q) . [Rz(theta) Tx(a) Rx(alpha)]      fixed origin xyz = (a cos t, a sin t, 0), rpy = (alpha, 0, theta)
+(Rz and Tz commute, so the P form equals Rz(theta) Tz(q) Tx(a) Rx(alpha).) The workpiece frame W hangs
+off the base at the optimized placement T_BW = Trans(xyz) Rz(yaw) Ry(pitch) Rx(roll) -- URDF's own
+rpy convention -- and carries the toolpath as small spheres.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+BASE, TOOL, WORKPIECE = "base", "tool", "workpiece"
+
+
+def _origin(xyz, rpy) -> np.ndarray:
+    from designopt.kinematics.transforms import rot_x, rot_y, rot_z
+
+    T = rot_z(rpy[2]) @ rot_y(rpy[1]) @ rot_x(rpy[0])
+    T[:3, 3] = xyz
+    return T
+
+
+def urdf_model(data: dict, name: str = "designopt_cell", sphere_radius: float = 0.004):
+    """A yourdfpy URDF of the solution's robot and cell (not yet written)."""
+    import yourdfpy as y
+
+    grey = y.Material(name="link", color=y.Color(rgba=np.array([0.3, 0.45, 0.7, 1.0])))
+    red = y.Material(name="path", color=y.Color(rgba=np.array([0.8, 0.1, 0.1, 1.0])))
+    links = [y.Link(name=BASE, visuals=[y.Visual(geometry=y.Geometry(sphere=y.Sphere(0.03)), material=grey)])]
+    joints = []
+    parent = BASE
+    limits = data.get("joint_limits") or [{} for _ in data["dh"]]
+    for i, (row, lim) in enumerate(zip(data["dh"], limits, strict=True), start=1):
+        moving, frame = f"link{i}_moving", f"frame{i}"
+        lower = lim.get("lower", -2 * np.pi if row["type"] == "R" else -2.0)
+        upper = lim.get("upper", 2 * np.pi if row["type"] == "R" else 2.0)
+        joints.append(y.Joint(
+            name=f"joint{i}", type="revolute" if row["type"] == "R" else "prismatic", parent=parent, child=moving,
+            origin=np.eye(4), axis=np.array([0.0, 0.0, 1.0]),
+            limit=y.Limit(effort=0.0, velocity=float(lim.get("velocity_per_task_time", 10.0)),
+                          lower=float(lower), upper=float(upper))))
+        if row["type"] == "R":
+            origin = _origin((row["a"], 0.0, row["d"]), (row["alpha"], 0.0, 0.0))
+        else:
+            t = row["theta"]
+            origin = _origin((row["a"] * np.cos(t), row["a"] * np.sin(t), 0.0), (row["alpha"], 0.0, t))
+        length = float(np.linalg.norm(origin[:3, 3]))
+        visuals = [y.Visual(geometry=y.Geometry(sphere=y.Sphere(0.02)), material=grey)]
+        links += [y.Link(name=moving, visuals=visuals), y.Link(name=frame)]
+        joints.append(y.Joint(name=f"link{i}_dh", type="fixed", parent=moving, child=frame, origin=origin))
+        if length > 1e-9:  # draw the link as a cylinder from the joint to the next frame
+            direction = origin[:3, 3] / length
+            z = np.array([0.0, 0.0, 1.0])
+            axis = np.cross(z, direction)
+            angle = np.arctan2(np.linalg.norm(axis), z @ direction)
+            R = _axis_angle(axis, angle)
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = R, origin[:3, 3] / 2
+            visuals.append(y.Visual(origin=T, geometry=y.Geometry(cylinder=y.Cylinder(0.012, length)), material=grey))
+        parent = frame
+    links.append(y.Link(name=TOOL))
+    joints.append(y.Joint(name="tool_mount", type="fixed", parent=parent, child=TOOL, origin=np.array(data["tool"])))
+    xyz, ypr = data["placement"]["xyz"], data["placement"]["ypr"]
+    path_visuals = []
+    for k, p in enumerate(data["toolpath"]["points_W"]):
+        T = np.eye(4)
+        T[:3, 3] = p
+        path_visuals.append(y.Visual(name=f"waypoint{k}", origin=T, geometry=y.Geometry(sphere=y.Sphere(sphere_radius)),
+                                     material=red))
+    links.append(y.Link(name=WORKPIECE, visuals=path_visuals))
+    joints.append(y.Joint(name="placement", type="fixed", parent=BASE, child=WORKPIECE,
+                          origin=_origin(xyz, (ypr[2], ypr[1], ypr[0]))))
+    robot = y.Robot(name=name, links=links, joints=joints, materials=[grey, red])
+    return y.URDF(robot=robot, build_scene_graph=True, load_meshes=False)
+
+
+def _axis_angle(axis, angle) -> np.ndarray:
+    n = np.linalg.norm(axis)
+    if n < 1e-12:
+        return np.eye(3) if angle < np.pi / 2 else np.diag([1.0, -1.0, -1.0])
+    k = axis / n
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+def export(data: dict, out_dir: Path, stem: str = "cell") -> list[Path]:
+    """Write <stem>.urdf, <stem>_trajectory.csv and <stem>_trajectory.yaml into out_dir."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    urdf_path = out_dir / f"{stem}.urdf"
+    urdf_model(data).write_xml_file(str(urdf_path))
+    t, Q = data["toolpath"]["t"], data["q"]
+    names = [f"joint{i + 1}" for i in range(len(data["dh"]))]
+    csv_path = out_dir / f"{stem}_trajectory.csv"
+    with csv_path.open("w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(["t", *names])
+        for tk, q in zip(t, Q, strict=True):
+            writer.writerow([tk, *q])
+    yaml_path = out_dir / f"{stem}_trajectory.yaml"
+    yaml_path.write_text(yaml.safe_dump({
+        "joint_names": names, "time_unit": "normalised task time in [0, 1]",
+        "units": ["rad" if r["type"] == "R" else "m" for r in data["dh"]],
+        "points": [{"t": float(tk), "positions": [float(v) for v in q]} for tk, q in zip(t, Q, strict=True)],
+    }, sort_keys=False))
+    return [urdf_path, csv_path, yaml_path]
