@@ -174,6 +174,57 @@ def _read_solution(path: Path) -> dict:
     return data
 
 
+@app.command("sweep-structures")
+def sweep_structures(
+    config: Annotated[Path, typer.Option("--config", help="Base config (task, costs, solver).")]
+    = Path("configs/structures.yaml"),
+    min_dof: Annotated[int, typer.Option("--min-dof", min=1, max=12, help="Fewest joints.")] = 1,
+    max_dof: Annotated[int, typer.Option("--max-dof", min=1, max=12, help="Most joints.")] = 6,
+    jobs: Annotated[int, typer.Option("--jobs", help="Worker processes (-1: all cores).")] = -1,
+    out_dir: OutOpt = Path("results"),
+    name: Annotated[str, typer.Option("--name", help="Run name (reuse it with --resume).")] = "sweep",
+    resume: Annotated[bool, typer.Option("--resume", help="Skip finished solves of this run, do the rest.")] = False,
+    backend: Annotated[str, typer.Option("--backend", help="loky (local processes) or dask.")] = "loky",
+    scheduler: Annotated[str | None, typer.Option("--scheduler", help="dask scheduler address, e.g. tcp://host:8786 "
+                                                                       "(none: a LocalCluster).")] = None,
+):
+    """Solve every kinematic structure over {R, P} with min..max joints (TO + multistart), in parallel."""
+    from designopt.experiments.sweep import run_sweep
+
+    if min_dof > max_dof:
+        fail(f"--min-dof {min_dof} is above --max-dof {max_dof}")
+    if backend not in ("loky", "dask"):
+        fail(f"--backend: expected loky or dask, got {backend!r}")
+    cfg = load(config)
+    failed = 0
+    with _progress() as progress:
+        task = progress.add_task("structures", total=None)
+
+        def planned(p):
+            progress.update(task, total=len(p.tasks), description=f"{len(p.structures)} structures "
+                                                                  f"({p.skipped} solves already done)")
+
+        def done(sol):
+            nonlocal failed
+            failed += not sol.metrics.tracks
+            progress.update(task, advance=1, description=f"{sol.problem.chain.structure:>6}: {failed} not tracking")
+
+        try:
+            run = run_sweep(cfg, config.parent, out_dir, name, min_dof, max_dof, jobs, resume, backend, scheduler,
+                            on_plan=planned, on_solution=done)
+        except FileExistsError as exc:
+            fail(str(exc))
+    import pandas as pd
+
+    table = pd.read_csv(run.path / "table.csv")
+    solved = int(table["design_cost"].notna().sum())
+    out.print(f"{len(table)} structures solved, {solved} track the path; best per number of joints:")
+    best = table.dropna(subset=["design_cost"]).sort_values("design_cost").groupby("dof").head(1).sort_values("dof")
+    out.print(_frame_table(best[["dof", "structure", "n_prismatic", "design_cost", "tracking_starts", "starts"]],
+                           "best structure per DOF"))
+    out.print(f"results: {run.path}")
+
+
 @app.command()
 def export(
     solution: Annotated[Path, typer.Argument(help="A solution file (designopt.solution/1).")],

@@ -121,6 +121,7 @@ class CostsConfig(_Strict):
     tracking_weight: Positive = 1.0e4
     regularization: Annotated[float, Field(ge=0)] = 1.0e-3
     deflection: Literal["full", "translational"] = "full"
+    deformation_weight: Positive = 1.0
     smoothness: Annotated[float, Field(ge=0)] = 1.0e-9
     joint_regularization: Annotated[float, Field(ge=0)] = 1.0e-7
 
@@ -141,6 +142,7 @@ class SolverConfig(_Strict):
     jobs: Annotated[int, Field(ge=-1)] = -1
     perturbation: Annotated[float, Field(ge=0)] = 0.3
     init: Literal["ik", "constant"] = "ik"
+    compile: Literal["none", "O0", "O1", "O2"] = "O0"
     time_limit: Positive = 300.0
 
 

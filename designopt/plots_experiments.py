@@ -70,3 +70,48 @@ def waypoint_figure(table: pd.DataFrame, directory: Path) -> list[Path]:
     fig.suptitle("Waypoint study (TO, design + placement)", fontsize=9)
     fig.tight_layout()
     return save(fig, directory, "waypoints")
+
+
+def _ranked_bars(ax, rows: pd.DataFrame, title: str) -> None:
+    rows = rows.sort_values("design_cost")
+    colors = ["C2" if np.isfinite(c) else "lightgrey" for c in rows["design_cost"]]
+    ax.bar(range(len(rows)), rows["design_cost"].fillna(0), color=colors)
+    ax.set_xticks(range(len(rows)), rows["structure"], rotation=90, fontsize=7, family="monospace")
+    ax.set_yscale("log")
+    ax.set_ylabel("design cost (best tracking start)")
+    ax.set_title(title, fontsize=9)
+
+
+def structure_figures(table: pd.DataFrame, directory: Path) -> list[Path]:
+    """The paper's structure figures plus best cost per number of joints."""
+    paths = []
+    six = table[table["dof"] == 6]
+    if len(six):
+        fig, ax = plt.subplots(figsize=(6, 3.5))
+        ax.scatter(six["n_prismatic"], six["design_cost"], s=14, alpha=0.6, label="each 6-DOF structure")
+        best = six.groupby("n_prismatic")["design_cost"].min()
+        ax.plot(best.index, best.values, "o-", color="C3", label="best per number of P joints")
+        ax.set_yscale("log")
+        ax.set_xlabel("number of prismatic joints")
+        ax.set_ylabel("design cost (best tracking start)")
+        ax.set_title("6-DOF structures: design cost against prismatic joints", fontsize=9)
+        ax.legend(fontsize=7)
+        paths += save(fig, directory, "structures_6dof_by_prismatic")
+    for dof, stem in ((6, "structures_3R3P"), (5, "structures_5dof_3P")):
+        rows = table[(table["dof"] == dof) & (table["n_prismatic"] == 3)]
+        if len(rows):
+            fig, ax = plt.subplots(figsize=(max(4, 0.3 * len(rows) + 1.5), 3.5))
+            _ranked_bars(ax, rows, f"{dof}-DOF structures with three prismatic joints, ranked")
+            paths += save(fig, directory, stem)
+    if len(table):
+        best = table.dropna(subset=["design_cost"]).sort_values("design_cost").groupby("dof").head(1).sort_values("dof")
+        fig, ax = plt.subplots(figsize=(5, 3.2))
+        ax.semilogy(best["dof"], best["design_cost"], "o-")
+        for _, r in best.iterrows():
+            ax.annotate(r["structure"], (r["dof"], r["design_cost"]), textcoords="offset points", xytext=(4, 4),
+                        fontsize=7, family="monospace")
+        ax.set_xlabel("number of joints")
+        ax.set_ylabel("best design cost")
+        ax.set_title("Best structure per number of joints", fontsize=9)
+        paths += save(fig, directory, "structures_best_per_dof")
+    return paths

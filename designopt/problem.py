@@ -30,6 +30,7 @@ class DesignProblem:
     toolpath: toolpaths.Toolpath
     stiffness: Stiffness
     deflection: str = "full"
+    deformation_weight: float = 1.0
     tracking_weight: float = 1.0e4
     regularization: float = 1.0e-3
     smoothness: float = 1.0e-9
@@ -97,6 +98,7 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         toolpath=toolpath_from_config(cfg, base_dir),
         stiffness=stiffness_from_config(cfg),
         deflection=cfg.costs.deflection,
+        deformation_weight=cfg.costs.deformation_weight,
         tracking_weight=cfg.costs.tracking_weight,
         regularization=cfg.costs.regularization,
         smoothness=cfg.costs.smoothness,

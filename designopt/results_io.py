@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
+import io
 import os
 from pathlib import Path
 
@@ -46,15 +47,28 @@ class RunDirectory:
         (self.path / "config.yaml").write_text(text)
 
     def append_row(self, row: dict) -> None:
-        """Append one row to summary.csv (header written with the first row), flushed to disk."""
-        new = not self.summary.exists()
-        with self.summary.open("a", newline="") as fh:
-            writer = csv.DictWriter(fh, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore")
-            if new:
-                writer.writeheader()
-            writer.writerow({k: _fmt(row.get(k, "")) for k in SUMMARY_COLUMNS})
-            fh.flush()
-            os.fsync(fh.fileno())
+        """Append one row to summary.csv (header with the first row) in one O_APPEND write, then fsync,
+        so a process killed at any moment leaves whole rows only."""
+        buffer = io.StringIO()
+        writer = csv.DictWriter(buffer, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore", lineterminator="\n")
+        if not self.summary.exists() or self.summary.stat().st_size == 0:
+            writer.writeheader()
+        writer.writerow({k: _fmt(row.get(k, "")) for k in SUMMARY_COLUMNS})
+        fd = os.open(self.summary, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        try:
+            os.write(fd, buffer.getvalue().encode())
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+    def finished(self) -> set[tuple[str, str, str, int]]:
+        """(case, method, structure, seed) of every recorded row whose solution file exists."""
+        if not self.summary.exists():
+            return set()
+        with self.summary.open(newline="") as fh:
+            rows = list(csv.DictReader(fh))
+        return {(r["case"], r["method"], r["structure"], int(r["seed"])) for r in rows
+                if r.get("solution_file") and (self.path / r["solution_file"]).exists()}
 
     def log(self, message: str) -> None:
         stamp = dt.datetime.now().isoformat(timespec="seconds")

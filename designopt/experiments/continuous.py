@@ -44,7 +44,7 @@ def case_config(cfg: Config, case: str) -> Config:
 
 def method_transcription(cfg: Config, method: str):
     s = cfg.solver
-    options = {"max_iter": s.max_iter, "ipopt": {"ipopt.max_wall_time": float(s.time_limit)}}
+    options = {"max_iter": s.max_iter, "compile": s.compile, "ipopt": {"ipopt.max_wall_time": float(s.time_limit)}}
     if method == "to":
         options.update(kinematics=s.kinematics, tracking=s.tracking, degree=s.degree)
     return transcription_named(method, **options)

@@ -27,7 +27,7 @@ class RunResult:
 def transcription_from_config(cfg: Config) -> Collocation:
     s = cfg.solver
     return Collocation(
-        kinematics=s.kinematics, tracking=s.tracking, degree=s.degree, max_iter=s.max_iter,
+        kinematics=s.kinematics, tracking=s.tracking, degree=s.degree, max_iter=s.max_iter, compile=s.compile,
         ipopt={"ipopt.max_wall_time": float(s.time_limit)},
     )
 

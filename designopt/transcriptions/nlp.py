@@ -18,6 +18,7 @@ from designopt.transcriptions.base import RawResult, ipopt_options, waypoint_fun
 from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
 
 Z_DOWN = np.array([0.0, 0.0, -1.0])
+PRE_ITERATION_STATUSES = {"Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition", "Invalid_Option"}
 
 
 @dataclass
@@ -78,11 +79,14 @@ class WaypointNLP:
         return np.asarray(sol["x"]).ravel(), float(sol["f"]), self.solver.stats(), wall
 
     def result(self, q_d, Q, V, objective, stats, wall, seed, drift=0.0) -> RawResult:
+        status = str(stats.get("return_status", "unknown"))
+        # IPOPT stops these before its first iteration, and the reported count is then stale.
+        iterations = 0 if status in PRE_ITERATION_STATUSES else int(stats.get("iter_count", -1))
         return RawResult(
             q_d=q_d, Q=Q, V=V,
-            status=str(stats.get("return_status", "unknown")),
+            status=status,
             success=bool(stats.get("success", False)),
-            iterations=int(stats.get("iter_count", -1)),
+            iterations=iterations,
             solve_time_s=wall, build_time_s=self.build_time_s, objective=objective,
             n_variables=self.n_variables, n_constraints=self.n_constraints, seed=seed, kinematic_drift=drift,
         )
@@ -113,7 +117,9 @@ def waypoint_terms(problem: DesignProblem, tracking: str, position_in_terms: boo
     y = ca.SX.sym("y", n_m + n_d)
     s_W, f_W = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3)
     p_W, z_W, L_d, rho2, _ = waypoint_function(problem)(y[:n_m], y[n_m:], s_W, f_W)
-    phi = h * L_d
+    # deformation_weight only rescales the objective (a unit choice for physical stiffness models, whose
+    # L_d is ~1e-8 m^2 and would otherwise be drowned by the regularisation); the reported cost is unscaled.
+    phi = h * problem.deformation_weight * L_d
     c, lo, hi = [], [], []
     if tracking == "epsilon":
         c.append(ca.sumsqr(p_W - s_W) + ca.sumsqr(z_W - ca.DM(Z_DOWN)))

@@ -1,0 +1,127 @@
+"""The structure sweep: enumeration, end to end, killed and resumed, Dask against loky, failures as rows."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from cli.main import app
+from designopt.experiments.sweep import enumerate_structures
+from designopt.verify import verify_file
+
+runner = CliRunner()
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_enumeration_count_and_order():
+    all6 = enumerate_structures(1, 6)
+    assert len(all6) == 126 == sum(2**n for n in range(1, 7))
+    assert len(set(all6)) == 126
+    assert all6[:6] == ["R", "P", "RR", "RP", "PR", "PP"]
+    assert enumerate_structures(6, 6)[0] == "RRRRRR" and enumerate_structures(6, 6)[-1] == "PPPPPP"
+    assert sum(s.count("P") == 3 for s in enumerate_structures(6, 6)) == 20
+
+
+def small_config(tmp_path, **solver) -> Path:
+    path = tmp_path / "sweep.yaml"
+    path.write_text(yaml.safe_dump({
+        "name": "structures",
+        "toolpath": {"kind": "line", "length": 0.2, "waypoints": 8},
+        "placement": {"xyz": [0.3, 0.0, -0.2]},
+        "solver": {"multistart": 1, "max_iter": 200, **solver},
+    }))
+    return path
+
+
+@pytest.fixture(scope="module", autouse=True)
+def shared_cache(tmp_path_factory):
+    os.environ["DESIGNOPT_CACHE"] = str(tmp_path_factory.mktemp("cache"))
+
+
+def sweep(config, out, *extra):
+    return runner.invoke(app, ["sweep-structures", "--config", str(config), "--out", str(out), *extra])
+
+
+def test_sweep_1_to_2_dof_end_to_end(tmp_path):
+    result = sweep(small_config(tmp_path), tmp_path / "r", "--max-dof", "2", "--jobs", "2", "--name", "a")
+    assert result.exit_code == 0, result.output
+    run = tmp_path / "r" / "structures" / "a"
+    summary = pd.read_csv(run / "summary.csv")
+    assert sorted(summary["structure"]) == sorted(["R", "P", "RR", "RP", "PR", "PP"])
+    assert "6 structures solved" in result.output
+    table = pd.read_csv(run / "table.csv")
+    assert list(table["structure"]) == ["R", "P", "RR", "RP", "PR", "PP"]
+    for f in (run / "solutions").glob("*.json"):
+        assert verify_file(f) == [], f
+    assert (run / "figures" / "structures_best_per_dof.png").is_file()
+    again = sweep(small_config(tmp_path), tmp_path / "r", "--max-dof", "2", "--name", "a")
+    assert again.exit_code == 2 and "--resume" in again.output
+
+
+def test_failed_solves_are_rows(tmp_path):
+    # 1 joint cannot meet 5 tracking equalities per waypoint (IPOPT: Not_Enough_Degrees_Of_Freedom);
+    # 2 joints stopped after 2 iterations do not converge (Maximum_Iterations_Exceeded). Both are rows.
+    result = sweep(small_config(tmp_path, max_iter=2), tmp_path / "r", "--max-dof", "2", "--jobs", "1")
+    assert result.exit_code == 0, result.output
+    summary = pd.read_csv(tmp_path / "r" / "structures" / "sweep" / "summary.csv")
+    assert len(summary) == 6
+    assert not summary["success"].any() and not summary["tracks"].any()
+    statuses = dict(zip(summary["structure"], summary["status"], strict=True))
+    assert statuses["R"] == statuses["P"] == "Not_Enough_Degrees_Of_Freedom"
+    assert statuses["RR"] == "Maximum_Iterations_Exceeded"
+    assert "0 track the path" in result.output
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def test_killed_sweep_resumes_without_losing_or_repeating(tmp_path):
+    config = small_config(tmp_path)
+    out = tmp_path / "r"
+    cmd = [sys.executable, "-m", "cli.main", "sweep-structures", "--config", str(config), "--out", str(out),
+           "--min-dof", "1", "--max-dof", "3", "--jobs", "1", "--name", "k"]
+    proc = subprocess.Popen(cmd, cwd=ROOT, start_new_session=True, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    summary = out / "structures" / "k" / "summary.csv"
+    deadline = time.time() + 240
+    while time.time() < deadline:
+        if summary.exists() and len(summary.read_text().splitlines()) >= 4:  # header + 3 rows
+            break
+        time.sleep(0.2)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    before = pd.read_csv(summary)
+    assert 3 <= len(before) < 14, "the sweep was not killed part-way"
+    kept = {f: _digest(out / "structures" / "k" / f) for f in before["solution_file"]}
+    prefix = summary.read_bytes()
+
+    result = sweep(config, out, "--min-dof", "1", "--max-dof", "3", "--jobs", "2", "--name", "k", "--resume")
+    assert result.exit_code == 0, result.output
+    after = pd.read_csv(summary)
+    assert sorted(after["structure"]) == sorted(enumerate_structures(1, 3))  # each exactly once
+    assert summary.read_bytes().startswith(prefix)  # finished rows untouched, byte for byte
+    for f, digest in kept.items():
+        assert _digest(out / "structures" / "k" / f) == digest
+
+
+def test_dask_local_cluster_gives_the_same_rows_as_loky(tmp_path):
+    pytest.importorskip("dask.distributed")
+    config = small_config(tmp_path)
+    a = sweep(config, tmp_path / "r", "--max-dof", "1", "--name", "loky", "--jobs", "2")
+    b = sweep(config, tmp_path / "r", "--max-dof", "1", "--name", "dask", "--backend", "dask", "--jobs", "2")
+    assert a.exit_code == 0 and b.exit_code == 0, (a.output, b.output)
+    cols = ["structure", "seed", "status", "iterations", "design_cost", "tracks"]
+    loky = pd.read_csv(tmp_path / "r" / "structures" / "loky" / "summary.csv")[cols].sort_values("structure")
+    dask = pd.read_csv(tmp_path / "r" / "structures" / "dask" / "summary.csv")[cols].sort_values("structure")
+    pd.testing.assert_frame_equal(loky.reset_index(drop=True), dask.reset_index(drop=True), rtol=1e-9)
