@@ -226,6 +226,28 @@ def sweep_structures(
 
 
 @app.command()
+def modular(
+    config: ConfigArg = Path("configs/modular.yaml"),
+    out_dir: OutOpt = Path("results"),
+    name: NameOpt = None,
+):
+    """Modular design: continuous TO with L_mod, round links to modules, re-solve placement (+ FK, plain TO)."""
+    from designopt.config import ConfigError
+    from designopt.experiments.modular import run_modular
+
+    cfg = load(config)
+    with _progress() as progress:
+        task = progress.add_task("modular", total=4 * cfg.solver.multistart)
+        try:
+            result = run_modular(cfg, config.parent, out_dir, name, config_file=str(config),
+                                 on_solution=lambda case, _s: progress.update(task, advance=1, description=case))
+        except ConfigError as exc:
+            fail(str(exc))
+    out.print(_frame_table(result.table, "modular design: best tracking start per stage"))
+    out.print(f"results: {result.directory.path}")
+
+
+@app.command()
 def export(
     solution: Annotated[Path, typer.Argument(help="A solution file (designopt.solution/1).")],
     out_dir: Annotated[Path | None, typer.Option("--out", help="Directory (default: next to the solution).")] = None,

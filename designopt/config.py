@@ -158,6 +158,31 @@ class ContinuousConfig(_Strict):
     waypoint_study: list[Annotated[int, Field(ge=3, le=2000)]] = [20, 40, 80, 160, 320]
 
 
+class ModuleRow(_Strict):
+    """One module: the DH values it fixes (theta is ignored for R modules, d for P modules)."""
+
+    theta: float = 0.0
+    d: float = 0.0
+    a: float = 0.0
+    alpha: float = 0.0
+
+
+_PAPER_MODULES = [ModuleRow(d=0.0, a=0.5, alpha=0.0), ModuleRow(d=0.0, a=0.5, alpha=math.pi / 2),
+                  ModuleRow(d=1.0, a=0.0, alpha=0.0), ModuleRow(d=1.0, a=0.5, alpha=0.0),
+                  ModuleRow(d=0.5, a=0.5, alpha=-math.pi / 2)]
+
+
+class ModularConfig(_Strict):
+    """The modular design problem (SPEC §5): catalogue, similarity weights, L_mod weight and its study."""
+
+    joint_type: Literal["R", "P"] = "R"
+    modules: Annotated[list[ModuleRow], Field(min_length=1)] = _PAPER_MODULES
+    weight: Positive = 1.0e-3
+    linear_weight: Positive = 1.0
+    angular_weight: Positive = 0.25
+    weight_study: list[Positive] = [1.0e-4, 1.0e-3, 1.0e-2]
+
+
 class Config(_Strict):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]+$")] = "run"
     toolpath: ToolpathConfig = FigureEight(kind="figure_eight")
@@ -167,6 +192,7 @@ class Config(_Strict):
     tolerance: ToleranceConfig = ToleranceConfig()
     solver: SolverConfig = SolverConfig()
     continuous: ContinuousConfig = ContinuousConfig()
+    modular: ModularConfig = ModularConfig()
 
 
 def _key(loc: tuple) -> str:

@@ -29,9 +29,11 @@ class Metrics:
     position_error: np.ndarray
     axis_error: np.ndarray
     min_standoff: float
+    design_costs: tuple[tuple[str, float], ...] = ()
 
     def row(self) -> dict:
         return {
+            **{f"cost_{name}": value for name, value in self.design_costs},
             "design_cost": self.design_cost,
             "regularization": self.regularization,
             "max_position_error": self.max_position_error,
@@ -79,4 +81,5 @@ def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> Metrics:
         position_error=pos_err,
         axis_error=axis_err,
         min_standoff=float(min(standoff)),
+        design_costs=tuple((c.name, float(c(chain, np.asarray(q_d, float)))) for c in problem.design_costs),
     )

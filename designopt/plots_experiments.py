@@ -115,3 +115,31 @@ def structure_figures(table: pd.DataFrame, directory: Path) -> list[Path]:
         ax.set_title("Best structure per number of joints", fontsize=9)
         paths += save(fig, directory, "structures_best_per_dof")
     return paths
+
+
+def _features(vectors: np.ndarray) -> np.ndarray:
+    """(offset, a, alpha) -> (offset, a, cos alpha, sin alpha): alpha and alpha + 2 pi coincide."""
+    return np.column_stack([vectors[:, 0], vectors[:, 1], np.cos(vectors[:, 2]), np.sin(vectors[:, 2])])
+
+
+def module_pca_figure(links: np.ndarray, modules: np.ndarray, assignment: list[int], directory: Path) -> list[Path]:
+    """Links of the continuous stage and the catalogue's modules in their first two principal components."""
+    X = np.vstack([_features(links), _features(modules)])
+    centred = X - X.mean(axis=0)
+    _, s, Vt = np.linalg.svd(centred, full_matrices=False)
+    P = centred @ Vt[:2].T
+    explained = s[:2] ** 2 / np.sum(s**2)
+    L, M = P[: len(links)], P[len(links):]
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.scatter(M[:, 0], M[:, 1], marker="s", s=80, facecolors="none", edgecolors="k", label="modules")
+    for k, (x, y) in enumerate(M):
+        ax.annotate(f"m{k + 1}", (x, y), textcoords="offset points", xytext=(6, -10), fontsize=8)
+    ax.scatter(L[:, 0], L[:, 1], color="C3", s=25, label="links (continuous TO with L_mod)")
+    for i, (x, y) in enumerate(L):
+        ax.annotate(f"L{i + 1}→m{assignment[i] + 1}", (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7,
+                    color="C3")
+    ax.set_xlabel(f"PC 1 ({explained[0]:.0%} of variance)")
+    ax.set_ylabel(f"PC 2 ({explained[1]:.0%} of variance)")
+    ax.set_title("Link design vectors and modules (d, a, cos α, sin α)", fontsize=9)
+    ax.legend(fontsize=7)
+    return save(fig, directory, "module_pca")

@@ -5,6 +5,7 @@ Transcriptions (TO collocation, the FK baseline) take a `DesignProblem` and neve
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -15,6 +16,18 @@ from designopt.config import Config, dh_rows
 from designopt.costs import Stiffness
 from designopt.design_space import JointBounds, build_chain, design_lengths
 from designopt.kinematics.joints import Chain
+
+
+@dataclass(frozen=True)
+class DesignCost:
+    """A named, weighted cost on the design joints only: weight * fn(chain, q_d) (numpy or CasADi)."""
+
+    name: str
+    weight: float
+    fn: Callable
+
+    def __call__(self, chain: Chain, q_d):
+        return self.weight * self.fn(chain, q_d)
 
 
 @dataclass(frozen=True)
@@ -39,6 +52,7 @@ class DesignProblem:
     keep_out_radius: float = 0.0
     position_tol: float = 1.0e-3
     axis_tol: float = 1.0e-2
+    design_costs: tuple[DesignCost, ...] = ()
 
     @property
     def k_inv(self) -> np.ndarray:

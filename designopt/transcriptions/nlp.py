@@ -120,6 +120,10 @@ def waypoint_terms(problem: DesignProblem, tracking: str, position_in_terms: boo
     # deformation_weight only rescales the objective (a unit choice for physical stiffness models, whose
     # L_d is ~1e-8 m^2 and would otherwise be drowned by the regularisation); the reported cost is unscaled.
     phi = h * problem.deformation_weight * L_d
+    # Costs on the design joints alone (e.g. L_mod) are spread evenly over the waypoints so that the
+    # per-waypoint blocks, and with them the exact structured Hessian, carry them too.
+    for cost in problem.design_costs:
+        phi += cost(problem.chain, y[n_m:]) / tp.n
     c, lo, hi = [], [], []
     if tracking == "epsilon":
         c.append(ca.sumsqr(p_W - s_W) + ca.sumsqr(z_W - ca.DM(Z_DOWN)))

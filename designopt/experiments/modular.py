@@ -1,0 +1,138 @@
+"""The modular design problem (SPEC §5, claim C7): continuous TO with L_mod -> round -> re-solve.
+
+Stages, each written to summary.csv as a ``case``:
+  continuous          plain TO, design + placement (the reference continuous cost)
+  continuous_modular  TO with weight * L_mod added: links are pulled toward catalogue modules
+  rounded             every link replaced by its nearest module, evaluated on the stage-2 trajectory
+  modular             modules fixed; placement and trajectory re-solved (the modular design)
+  fk                  the FK baseline on the continuous problem, for comparison (C7)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from designopt.config import Config, ConfigError, dump_config
+from designopt.evaluation import evaluate
+from designopt.experiments.continuous import case_config, method_transcription
+from designopt.experiments.run import multistart_from_config, record, transcription_from_config
+from designopt.kinematics.joints import Role
+from designopt.modular import Catalogue, check_catalogue, link_vectors, modular_cost, nearest_modules
+from designopt.multistart import best_solution, run_multistart
+from designopt.problem import DesignCost, DesignProblem, problem_from_config
+from designopt.results_io import RunDirectory
+from designopt.solution import Solution, write_solution
+
+STAGES = ("continuous", "continuous_modular", "rounded", "modular", "fk")
+
+
+def catalogue_from_config(cfg: Config) -> Catalogue:
+    m = cfg.modular
+    offset = "d" if m.joint_type == "R" else "theta"
+    modules = tuple((getattr(row, offset), row.a, row.alpha) for row in m.modules)
+    return Catalogue(m.joint_type, modules, m.linear_weight, m.angular_weight)
+
+
+def with_modular_cost(problem: DesignProblem, catalogue: Catalogue, weight: float) -> DesignProblem:
+    cost = DesignCost("modular", weight, partial(modular_cost, catalogue=catalogue))
+    return replace(problem, design_costs=(*problem.design_costs, cost))
+
+
+def module_values(problem: DesignProblem, assignment: list[int], catalogue: Catalogue) -> dict[str, float]:
+    """DH values of every link under a module assignment."""
+    values = {}
+    for i, k in enumerate(assignment):
+        for param, v in zip(catalogue.params(), catalogue.modules[k], strict=True):
+            values[f"link{i + 1}.{param}"] = float(v)
+    return values
+
+
+def fix_modules(problem: DesignProblem, assignment: list[int], catalogue: Catalogue,
+                placement: dict[str, float]) -> DesignProblem:
+    """The problem with every link fixed to its module; only placement (and trajectory) stay free."""
+    values = module_values(problem, assignment, catalogue)
+    chain = problem.chain.with_roles(dict.fromkeys(values, Role.FIXED), {**values, **placement})
+    return replace(problem, chain=chain, design_costs=())
+
+
+def rounded_solution(sol: Solution, assignment: list[int], catalogue: Catalogue) -> Solution:
+    """The stage-2 solution with its links snapped to modules, evaluated on the same joint trajectory."""
+    names = [j.name for j in sol.problem.chain.design]
+    values = module_values(sol.problem, assignment, catalogue)
+    q_d = np.array([values.get(n, v) for n, v in zip(names, sol.raw.q_d, strict=True)])
+    raw = replace(sol.raw, q_d=q_d, status="rounded", success=False, iterations=0, solve_time_s=0.0)
+    return Solution(sol.problem, "rounded", raw, evaluate(sol.problem, q_d, sol.raw.Q), "rounded")
+
+
+@dataclass(frozen=True)
+class ModularResult:
+    directory: RunDirectory
+    table: pd.DataFrame
+    assignment: list[int]
+
+
+def _stage(run, problem, transcription, settings, case, on_solution) -> Solution | None:
+    sols = []
+    for sol in run_multistart(problem, transcription, settings, case):
+        record(run, sol, "modular", case)
+        sols.append(sol)
+        if on_solution:
+            on_solution(case, sol)
+    return best_solution(sols)
+
+
+def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
+                on_solution: Callable[[str, Solution], None] | None = None, figures: bool = True,
+                config_file: str = "<config>") -> ModularResult:
+    catalogue = catalogue_from_config(cfg)
+    try:
+        check_catalogue(cfg.robot.structure, catalogue)
+    except ValueError as exc:
+        raise ConfigError(config_file, "robot.structure", str(exc)) from None
+    run = RunDirectory.create(out_root, "modular", run_name)
+    run.write_config(dump_config(cfg))
+    settings = multistart_from_config(cfg)
+    combined_cfg = case_config(cfg, "combined")
+    base = problem_from_config(combined_cfg, base_dir)
+    to = transcription_from_config(combined_cfg)
+    best = {"continuous": _stage(run, base, to, settings, "continuous", on_solution)}
+    best["fk"] = _stage(run, base, method_transcription(combined_cfg, "fk"), settings, "fk", on_solution)
+    continuous = _stage(run, with_modular_cost(base, catalogue, cfg.modular.weight), to, settings,
+                        "continuous_modular", on_solution)
+    best["continuous_modular"] = continuous
+    assignment: list[int] = []
+    if continuous is not None:
+        assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)
+        rounded = rounded_solution(continuous, assignment, catalogue)
+        record(run, rounded, "modular", "rounded")
+        best["rounded"] = rounded
+        placement = {j.name: float(v) for j, v in zip(base.chain.design, continuous.raw.q_d, strict=True)
+                     if j.name.startswith("placement.")}
+        best["modular"] = _stage(run, fix_modules(base, assignment, catalogue, placement), to, settings, "modular",
+                                 on_solution)
+        run.log(f"modules per link: {[k + 1 for k in assignment]}")
+    rows = []
+    for stage in STAGES:
+        sol = best.get(stage)
+        rows.append({"stage": stage, "design_cost": sol.metrics.design_cost if sol else np.nan,
+                     "tracks": bool(sol and sol.metrics.tracks),
+                     "max_position_error": sol.metrics.max_position_error if sol else np.nan,
+                     "max_joint_step": sol.metrics.max_joint_step if sol else np.nan,
+                     "modules": " ".join(f"m{k + 1}" for k in assignment) if stage in ("rounded", "modular") else ""})
+        if sol is not None:
+            write_solution(sol, run.path / f"best-{stage}.json")
+    table = pd.DataFrame(rows)
+    table.to_csv(run.path / "table.csv", index=False)
+    if figures and continuous is not None:
+        from designopt import plots_experiments
+
+        vectors = np.array(link_vectors(continuous.problem.chain, continuous.raw.q_d, catalogue), float)
+        plots_experiments.module_pca_figure(vectors, np.array(catalogue.modules), assignment, run.figures)
+    run.log("done")
+    return ModularResult(run, table, assignment)

@@ -1,0 +1,97 @@
+"""Modules (SPEC §3, §5): a catalogue of DH links, the similarity cost L_mod, and rounding.
+
+A module fixes every DH parameter of a link except the moving one (theta of an R link, d of a P link).
+The distance between a link's design vector and a module is
+    dist = w_lin (Delta d^2 + Delta a^2) + w_ang * 2 (1 - cos Delta alpha)   (R links)
+and the same with theta in place of d for P links, where the cosine form makes alpha and alpha + 2 pi the
+same angle. L_mod = sum_i prod_k dist(link i, module k) is zero exactly when every link is a module.
+Functions work on numpy and CasADi values alike.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from designopt.kinematics.joints import Chain
+
+PAPER_MODULES = (  # Table II of the paper: (theta free, d, a, alpha)
+    {"d": 0.0, "a": 0.5, "alpha": 0.0},
+    {"d": 0.0, "a": 0.5, "alpha": math.pi / 2},
+    {"d": 1.0, "a": 0.0, "alpha": 0.0},
+    {"d": 1.0, "a": 0.5, "alpha": 0.0},
+    {"d": 0.5, "a": 0.5, "alpha": -math.pi / 2},
+)
+
+
+@dataclass(frozen=True)
+class Catalogue:
+    """Modules of one joint type. Each module: (offset, a, alpha) with offset = d (R) or theta (P)."""
+
+    joint_type: str
+    modules: tuple[tuple[float, float, float], ...]
+    w_lin: float = 1.0
+    w_ang: float = 1.0
+
+    def params(self) -> tuple[str, str, str]:
+        """Which DH parameters a module fixes, in the order of its tuple."""
+        return ("d", "a", "alpha") if self.joint_type == "R" else ("theta", "a", "alpha")
+
+
+def _cos(x):
+    import casadi as ca
+
+    return ca.cos(x) if isinstance(x, (ca.SX, ca.MX)) else np.cos(x)
+
+
+def distance(link, module, catalogue: Catalogue):
+    """Weighted distance between a link's (offset, a, alpha) and a module; angles through 1 - cos."""
+    offset, a, alpha = link
+    m_offset, m_a, m_alpha = module
+    if catalogue.joint_type == "R":
+        linear = (offset - m_offset) ** 2 + (a - m_a) ** 2
+        angular = 2 * (1 - _cos(alpha - m_alpha))
+    else:  # theta is an angle too on a P link
+        linear = (a - m_a) ** 2
+        angular = 2 * (1 - _cos(alpha - m_alpha)) + 2 * (1 - _cos(offset - m_offset))
+    return catalogue.w_lin * linear + catalogue.w_ang * angular
+
+
+def link_vectors(chain: Chain, q_d, catalogue: Catalogue) -> list[list]:
+    """Each link's (offset, a, alpha), taken from q_d where they are design joints, else fixed values."""
+    values = chain.link_values(np.zeros(chain.n_moving), q_d) if not _symbolic(q_d) else \
+        chain.link_values([0.0] * chain.n_moving, q_d)
+    index = {"theta": 0, "d": 1, "a": 2, "alpha": 3}
+    return [[row[index[p]] for p in catalogue.params()] for row in values]
+
+
+def _symbolic(x) -> bool:
+    import casadi as ca
+
+    return isinstance(x, (ca.SX, ca.MX))
+
+
+def modular_cost(chain: Chain, q_d, catalogue: Catalogue):
+    """L_mod = sum over links of the product over modules of dist(link, module)."""
+    total = 0
+    for link in link_vectors(chain, q_d, catalogue):
+        prod = 1
+        for module in catalogue.modules:
+            prod = prod * distance(link, module, catalogue)
+        total = total + prod
+    return total
+
+
+def nearest_modules(chain: Chain, q_d, catalogue: Catalogue) -> list[int]:
+    """Index of the nearest module for every link (by the same weighted distance)."""
+    return [int(np.argmin([distance(np.asarray(link, float), m, catalogue) for m in catalogue.modules]))
+            for link in link_vectors(chain, np.asarray(q_d, float), catalogue)]
+
+
+def check_catalogue(structure: str, catalogue: Catalogue) -> None:
+    """The paper's assumption: every link has the catalogue's joint type."""
+    if set(structure) != {catalogue.joint_type}:
+        raise ValueError(f"structure {structure} mixes joint types; all modules are {catalogue.joint_type} "
+                         f"joints (the three-step method assumes one joint type and a fixed number of joints)")

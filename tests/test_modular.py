@@ -1,0 +1,136 @@
+"""Modules: L_mod, the angular distance, rounding, the fixed re-solve, a brute-force check, the CLI."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import casadi as ca
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from designopt.config import parse_config
+from designopt.design_space import build_chain
+from designopt.experiments.modular import catalogue_from_config, fix_modules, module_values, with_modular_cost
+from designopt.kinematics.joints import Role
+from designopt.modular import Catalogue, check_catalogue, distance, modular_cost, nearest_modules
+from designopt.problem import problem_from_config
+
+CAT = Catalogue("R", ((0.0, 0.5, 0.0), (0.0, 0.5, math.pi / 2), (1.0, 0.0, 0.0), (1.0, 0.5, 0.0),
+                      (0.5, 0.5, -math.pi / 2)), w_lin=1.0, w_ang=0.25)
+
+
+def chain_with_links(rows):
+    dh = [{"theta": 0.0, "d": d, "a": a, "alpha": al} for d, a, al in rows]
+    return build_chain("R" * len(rows), dh, ["d", "a", "alpha"], (0, 0, 0), (0, 0, 0), ())
+
+
+def test_lmod_is_zero_exactly_at_modules():
+    for combo in itertools.product(range(5), repeat=2):
+        chain = chain_with_links([CAT.modules[k] for k in combo])
+        assert modular_cost(chain, chain.design_values, CAT) == pytest.approx(0.0, abs=1e-15)
+        assert nearest_modules(chain, chain.design_values, CAT) == list(combo)
+
+
+@settings(max_examples=50, deadline=None)
+@given(d=st.floats(0, 2), a=st.floats(0, 2), alpha=st.floats(-3.1, 3.1))
+def test_lmod_is_positive_elsewhere(d, a, alpha):
+    chain = chain_with_links([(d, a, alpha)])
+    gaps = [distance((d, a, alpha), m, CAT) for m in CAT.modules]
+    value = modular_cost(chain, chain.design_values, CAT)
+    assert value == pytest.approx(np.prod(gaps), rel=1e-12, abs=1e-300)
+    if min(gaps) > 1e-9:
+        assert value > 0
+
+
+@settings(max_examples=50, deadline=None)
+@given(alpha=st.floats(-10, 10), k=st.integers(-3, 3))
+def test_angular_distance_treats_alpha_and_alpha_plus_2pi_alike(alpha, k):
+    module = (0.0, 0.5, 0.3)
+    assert distance((0.0, 0.5, alpha), module, CAT) == pytest.approx(
+        distance((0.0, 0.5, alpha + 2 * math.pi * k), module, CAT), abs=1e-9)
+    assert distance((0.0, 0.5, math.pi), (0.0, 0.5, -math.pi), CAT) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_rounding_picks_the_nearest_module_and_matches_brute_force(rng):
+    for _ in range(50):
+        link = (rng.uniform(0, 1.2), rng.uniform(0, 0.7), rng.uniform(-math.pi, math.pi))
+        chain = chain_with_links([link])
+        brute = min(range(5), key=lambda k: CAT.w_lin * ((link[0] - CAT.modules[k][0]) ** 2 +
+                                                           (link[1] - CAT.modules[k][1]) ** 2)
+                    + CAT.w_ang * 2 * (1 - math.cos(link[2] - CAT.modules[k][2])))
+        assert nearest_modules(chain, chain.design_values, CAT) == [brute]
+
+
+def test_lmod_symbolic_equals_numeric(rng):
+    chain = chain_with_links([(0.2, 0.3, 0.4), (0.9, 0.1, -1.0)])
+    q = ca.SX.sym("q", chain.n_design)
+    f = ca.Function("f", [q], [modular_cost(chain, q, CAT)])
+    x = rng.uniform(-1, 1, chain.n_design)
+    assert float(f(x)) == pytest.approx(modular_cost(chain, x, CAT), rel=1e-12)
+
+
+def test_the_resolve_keeps_modules_fixed():
+    cfg = parse_config({"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 6}})
+    problem = problem_from_config(cfg)
+    assignment = [0, 1, 2, 3, 4, 0]
+    fixed = fix_modules(problem, assignment, catalogue_from_config(cfg), {"placement.x": 0.7})
+    assert all(j.name.startswith("placement.") for j in fixed.chain.design)
+    values = module_values(problem, assignment, catalogue_from_config(cfg))
+    for name, v in values.items():
+        j = fixed.chain.joint(name)
+        assert j.role is Role.FIXED and j.value == v
+    assert fixed.chain.joint("placement.x").value == 0.7
+    assert fixed.design_costs == ()
+    assert with_modular_cost(problem, CAT, 1e-3).design_costs[0].name == "modular"
+
+
+def test_catalogue_assumptions():
+    check_catalogue("RRRRRR", CAT)
+    with pytest.raises(ValueError, match="one joint type"):
+        check_catalogue("RRPRRR", CAT)
+
+
+def test_modular_command_writes_every_stage(tmp_path):
+    import json
+
+    import pandas as pd
+    import yaml
+    from typer.testing import CliRunner
+
+    from cli.main import app
+    from designopt.verify import verify_file
+
+    config = tmp_path / "m.yaml"
+    config.write_text(yaml.safe_dump({"name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 10},
+                                      "placement": {"xyz": [0.45, 0.0, -0.2]},
+                                      "solver": {"multistart": 1, "max_iter": 300}}))
+    result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path / "r"), "--name", "t"])
+    assert result.exit_code == 0, result.output
+    run = tmp_path / "r" / "modular" / "t"
+    summary = pd.read_csv(run / "summary.csv")
+    assert set(summary["case"]) == {"continuous", "continuous_modular", "rounded", "modular", "fk"}
+    assert (run / "figures" / "module_pca.png").stat().st_size > 1000
+    modular_file = summary.loc[summary["case"] == "modular", "solution_file"].iloc[0]
+    final = json.loads((run / modular_file).read_text())
+    modules = set(catalogue_from_config(parse_config({})).modules)
+    for row in final["dh"]:  # every link is exactly a catalogue module
+        assert (row["d"], row["a"], row["alpha"]) in modules
+    assert set(final["design_joints"]) == {f"placement.{p}" for p in ("x", "y", "z", "yaw", "pitch", "roll")}
+    for f in (run / "solutions").glob("*.json"):
+        assert verify_file(f) == [], f
+
+
+def test_mixed_structure_is_a_one_line_error(tmp_path):
+    import yaml
+    from typer.testing import CliRunner
+
+    from cli.main import app
+
+    config = tmp_path / "m.yaml"
+    config.write_text(yaml.safe_dump({"robot": {"structure": "RRPRRR", "dh": "generic"}}))
+    result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path)])
+    assert result.exit_code == 2
+    assert "robot.structure" in result.output and "one joint type" in result.output
