@@ -24,9 +24,14 @@ lint: setup
 	$(BIN)/ruff check .
 
 # Every figure and table of the paper's results section, into results/ (see docs/results.md).
+# Sweeps resume: re-running `make figures` finishes an interrupted sweep instead of starting over.
 figures: setup
 	$(BIN)/designopt continuous configs/continuous.yaml --name paper
 	$(BIN)/designopt waypoints configs/continuous.yaml --name paper
+	$(BIN)/designopt sweep-structures --config configs/structures.yaml --name paper --resume
+	$(BIN)/designopt sweep-structures --config configs/structures_physical.yaml --name paper --resume
+	$(BIN)/designopt modular configs/modular.yaml --name paper
+	$(BIN)/designopt modular-study configs/modular.yaml --name paper
 
 benchmark: setup
 	$(BIN)/python benchmarks/bench_solve.py

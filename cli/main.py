@@ -247,6 +247,31 @@ def modular(
     out.print(f"results: {result.directory.path}")
 
 
+@app.command("modular-study")
+def modular_study(
+    config: ConfigArg = Path("configs/modular.yaml"),
+    out_dir: OutOpt = Path("results"),
+    name: NameOpt = None,
+):
+    """Beyond the paper: the L_mod weight study, and every module assignment of a small catalogue."""
+    from designopt.experiments.modular import run_modular_study
+
+    cfg = load(config)
+    with _progress() as progress:
+        task = progress.add_task("modular study", total=None)
+        try:
+            weights, enum = run_modular_study(cfg, config.parent, out_dir, name,
+                                              on_solution=lambda case, _s: progress.update(task, advance=1,
+                                                                                           description=case))
+        except ValueError as exc:
+            fail(f"{config}: robot.structure: {exc}")
+    out.print(_frame_table(weights, "L_mod weight study"))
+    out.print(_frame_table(enum.head(10), "best module assignments (small catalogue)"))
+    picked = enum[enum["rounding_picked"]]
+    if len(picked):
+        out.print(f"rounding picked rank {int(picked['rank'].iloc[0])} of {len(enum)}")
+
+
 @app.command()
 def export(
     solution: Annotated[Path, typer.Argument(help="A solution file (designopt.solution/1).")],

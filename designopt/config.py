@@ -181,6 +181,8 @@ class ModularConfig(_Strict):
     linear_weight: Positive = 1.0
     angular_weight: Positive = 0.25
     weight_study: list[Positive] = [1.0e-4, 1.0e-3, 1.0e-2]
+    enumeration_modules: Annotated[list[Annotated[int, Field(ge=1)]], Field(min_length=1, max_length=3)] = [2, 5]
+    enumeration_waypoints: Annotated[int, Field(ge=3)] = 40
 
 
 class Config(_Strict):

@@ -103,19 +103,12 @@ def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | Non
     to = transcription_from_config(combined_cfg)
     best = {"continuous": _stage(run, base, to, settings, "continuous", on_solution)}
     best["fk"] = _stage(run, base, method_transcription(combined_cfg, "fk"), settings, "fk", on_solution)
-    continuous = _stage(run, with_modular_cost(base, catalogue, cfg.modular.weight), to, settings,
-                        "continuous_modular", on_solution)
-    best["continuous_modular"] = continuous
-    assignment: list[int] = []
+    continuous, assignment, modular = _round_and_resolve(run, base, to, settings, catalogue, cfg.modular.weight, "",
+                                                         on_solution)
+    best["continuous_modular"], best["modular"] = continuous, modular
     if continuous is not None:
-        assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)
-        rounded = rounded_solution(continuous, assignment, catalogue)
-        record(run, rounded, "modular", "rounded")
-        best["rounded"] = rounded
-        placement = {j.name: float(v) for j, v in zip(base.chain.design, continuous.raw.q_d, strict=True)
-                     if j.name.startswith("placement.")}
-        best["modular"] = _stage(run, fix_modules(base, assignment, catalogue, placement), to, settings, "modular",
-                                 on_solution)
+        best["rounded"] = rounded_solution(continuous, assignment, catalogue)
+        record(run, best["rounded"], "modular", "rounded")
         run.log(f"modules per link: {[k + 1 for k in assignment]}")
     rows = []
     for stage in STAGES:
@@ -136,3 +129,67 @@ def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | Non
         plots_experiments.module_pca_figure(vectors, np.array(catalogue.modules), assignment, run.figures)
     run.log("done")
     return ModularResult(run, table, assignment)
+
+
+def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, on_solution):
+    """Stages 2-4 for one L_mod weight; returns (continuous best, assignment, modular best)."""
+    continuous = _stage(run, with_modular_cost(base, catalogue, weight), to, settings, f"{tag}continuous_modular",
+                        on_solution)
+    if continuous is None:
+        return None, [], None
+    assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)
+    placement = {j.name: float(v) for j, v in zip(base.chain.design, continuous.raw.q_d, strict=True)
+                 if j.name.startswith("placement.")}
+    modular = _stage(run, fix_modules(base, assignment, catalogue, placement), to, settings, f"{tag}modular",
+                     on_solution)
+    return continuous, assignment, modular
+
+
+def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
+                      on_solution: Callable[[str, Solution], None] | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Beyond the paper: (a) how the L_mod weight changes the result; (b) on a small catalogue where every
+    assignment can be solved, how far rounding lands from the best assignment."""
+    import itertools
+
+    catalogue = catalogue_from_config(cfg)
+    check_catalogue(cfg.robot.structure, catalogue)
+    run = RunDirectory.create(out_root, "modular_study", run_name)
+    run.write_config(dump_config(cfg))
+    settings = multistart_from_config(cfg)
+    combined_cfg = case_config(cfg, "combined")
+    base = problem_from_config(combined_cfg, base_dir)
+    to = transcription_from_config(combined_cfg)
+
+    weights = []
+    for w in cfg.modular.weight_study:
+        cont, assignment, mod = _round_and_resolve(run, base, to, settings, catalogue, w, f"w{w:g}-", on_solution)
+        weights.append({"weight": w, "continuous_cost": cont.metrics.design_cost if cont else np.nan,
+                        "L_mod": modular_cost(base.chain, cont.raw.q_d, catalogue) if cont else np.nan,
+                        "modules": " ".join(f"m{k + 1}" for k in assignment),
+                        "modular_cost": mod.metrics.design_cost if mod else np.nan})
+    weight_table = pd.DataFrame(weights)
+    weight_table.to_csv(run.path / "weight_study.csv", index=False)
+
+    # (b) enumeration on a sub-catalogue and a shorter path
+    subset = [k - 1 for k in cfg.modular.enumeration_modules]
+    small = replace(catalogue, modules=tuple(catalogue.modules[k] for k in subset))
+    n = cfg.modular.enumeration_waypoints
+    small_cfg = combined_cfg.model_copy(update={"toolpath": combined_cfg.toolpath.model_copy(update={"waypoints": n})})
+    small_base = problem_from_config(small_cfg, base_dir)
+    small_to = transcription_from_config(small_cfg)
+    _, rounded_assignment, rounded_best = _round_and_resolve(run, small_base, small_to, settings, small,
+                                                             cfg.modular.weight, "enum-", on_solution)
+    placement = {j.name: j.value for j in small_base.chain.design if j.name.startswith("placement.")}
+    rows = []
+    for assignment in itertools.product(range(len(subset)), repeat=small_base.chain.n_links):
+        best = _stage(run, fix_modules(small_base, list(assignment), small, placement), small_to, settings,
+                      "enum-" + "".join(str(subset[k] + 1) for k in assignment), on_solution)
+        rows.append({"assignment": " ".join(f"m{subset[k] + 1}" for k in assignment),
+                     "design_cost": best.metrics.design_cost if best else np.nan,
+                     "rounding_picked": list(assignment) == rounded_assignment})
+    enum = pd.DataFrame(rows).sort_values("design_cost", na_position="last").reset_index(drop=True)
+    enum["rank"] = np.arange(1, len(enum) + 1)
+    enum.to_csv(run.path / "enumeration.csv", index=False)
+    run.log(f"rounding picked {rounded_assignment}, its re-solve cost "
+            f"{rounded_best.metrics.design_cost if rounded_best else float('nan')}")
+    return weight_table, enum
