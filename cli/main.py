@@ -254,17 +254,18 @@ def modular_study(
     name: NameOpt = None,
 ):
     """Beyond the paper: the L_mod weight study, and every module assignment of a small catalogue."""
+    from designopt.config import ConfigError
     from designopt.experiments.modular import run_modular_study
 
     cfg = load(config)
     with _progress() as progress:
         task = progress.add_task("modular study", total=None)
         try:
-            weights, enum = run_modular_study(cfg, config.parent, out_dir, name,
+            weights, enum = run_modular_study(cfg, config.parent, out_dir, name, config_file=str(config),
                                               on_solution=lambda case, _s: progress.update(task, advance=1,
                                                                                            description=case))
-        except ValueError as exc:
-            fail(f"{config}: robot.structure: {exc}")
+        except ConfigError as exc:
+            fail(str(exc))
     out.print(_frame_table(weights, "L_mod weight study"))
     out.print(_frame_table(enum.head(10), "best module assignments (small catalogue)"))
     picked = enum[enum["rounding_picked"]]

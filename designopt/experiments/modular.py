@@ -87,20 +87,36 @@ def _stage(run, problem, transcription, settings, case, on_solution) -> Solution
     return best_solution(sols)
 
 
-def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                on_solution: Callable[[str, Solution], None] | None = None, figures: bool = True,
-                config_file: str = "<config>") -> ModularResult:
+@dataclass(frozen=True)
+class _Setup:
+    catalogue: Catalogue
+    run: RunDirectory
+    settings: object
+    combined: Config
+    base: DesignProblem
+    to: object
+
+
+def _setup(cfg: Config, base_dir: Path, out_root: Path, experiment: str, run_name: str | None,
+           config_file: str) -> _Setup:
+    """Catalogue (checked against the structure), run directory and the combined design + placement problem."""
     catalogue = catalogue_from_config(cfg)
     try:
         check_catalogue(cfg.robot.structure, catalogue)
     except ValueError as exc:
         raise ConfigError(config_file, "robot.structure", str(exc)) from None
-    run = RunDirectory.create(out_root, "modular", run_name)
+    run = RunDirectory.create(out_root, experiment, run_name)
     run.write_config(dump_config(cfg))
-    settings = multistart_from_config(cfg)
-    combined_cfg = case_config(cfg, "combined")
-    base = problem_from_config(combined_cfg, base_dir)
-    to = transcription_from_config(combined_cfg)
+    combined = case_config(cfg, "combined")
+    return _Setup(catalogue, run, multistart_from_config(cfg), combined, problem_from_config(combined, base_dir),
+                  transcription_from_config(combined))
+
+
+def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
+                on_solution: Callable[[str, Solution], None] | None = None, figures: bool = True,
+                config_file: str = "<config>") -> ModularResult:
+    s = _setup(cfg, base_dir, out_root, "modular", run_name, config_file)
+    catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
     best = {"continuous": _stage(run, base, to, settings, "continuous", on_solution)}
     best["fk"] = _stage(run, base, method_transcription(combined_cfg, "fk"), settings, "fk", on_solution)
     continuous, assignment, modular = _round_and_resolve(run, base, to, settings, catalogue, cfg.modular.weight, "",
@@ -146,19 +162,14 @@ def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, on_solut
 
 
 def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                      on_solution: Callable[[str, Solution], None] | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+                      on_solution: Callable[[str, Solution], None] | None = None,
+                      config_file: str = "<config>") -> tuple[pd.DataFrame, pd.DataFrame]:
     """Beyond the paper: (a) how the L_mod weight changes the result; (b) on a small catalogue where every
     assignment can be solved, how far rounding lands from the best assignment."""
     import itertools
 
-    catalogue = catalogue_from_config(cfg)
-    check_catalogue(cfg.robot.structure, catalogue)
-    run = RunDirectory.create(out_root, "modular_study", run_name)
-    run.write_config(dump_config(cfg))
-    settings = multistart_from_config(cfg)
-    combined_cfg = case_config(cfg, "combined")
-    base = problem_from_config(combined_cfg, base_dir)
-    to = transcription_from_config(combined_cfg)
+    s = _setup(cfg, base_dir, out_root, "modular_study", run_name, config_file)
+    catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
 
     weights = []
     for w in cfg.modular.weight_study:
