@@ -113,3 +113,18 @@ def test_a_failed_solve_is_a_result_not_an_exception(gantry_problem):
     raw = nlp.solve(initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0])
     assert not raw.success
     assert raw.status == "Maximum_Iterations_Exceeded"
+
+
+def test_axis_held_once_when_no_joint_turns_the_tool():
+    """A PPP chain cannot turn its tool: the axis equalities are the same at every waypoint. Held once, the
+    problem is regular and IPOPT converges (it stalled at max_iter when they were repeated N times)."""
+    from designopt.transcriptions.nlp import once_only_rows
+
+    problem = problem_from_config(parse_config(gantry_config(robot={"design": ["theta", "a", "alpha"]},
+                                                             placement={"optimize": True})))
+    assert list(once_only_rows(problem, "hard")) == [3, 4, 5]
+    assert len(once_only_rows(problem_from_config(parse_config({})), "hard")) == 0
+    raw = Collocation(max_iter=300).build(problem).solve(initial_guesses(problem, 1, 0, 0.1, "constant")[0])
+    sol = solve_and_evaluate(problem, "to", raw)
+    assert raw.success, raw.status
+    assert sol.metrics.tracks

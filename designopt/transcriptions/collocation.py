@@ -28,6 +28,7 @@ from designopt.transcriptions.nlp import (
     ConstraintList,
     WaypointNLP,
     joint_regularization,
+    once_only_rows,
     waypoint_terms,
     y_indices,
 )
@@ -115,7 +116,10 @@ class CollocationNLP:
 
         cons = ConstraintList()
         n_c = C.shape[0]
-        cons.add(C, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)))  # multipliers 0 .. n_c N
+        C_lo, C_hi = np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N))
+        once = once_only_rows(problem, scheme.tracking) if not differential else np.zeros(0, dtype=int)
+        C_lo[once, 1:], C_hi[once, 1:] = -np.inf, np.inf
+        cons.add(C, C_lo, C_hi)  # first, so that its multipliers are 0 .. n_c N
 
         if differential:
             P = Z[2 * n_m :, :]

@@ -147,3 +147,18 @@ def waypoint_terms(problem: DesignProblem, tracking: str, position_in_terms: boo
     fn = ca.Function("terms", [y, s_W, f_W], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
                      ["y", "s_W", "f_W"], ["phi", "c"])
     return fn, np.array(lo), np.array(hi)
+
+
+def once_only_rows(problem: DesignProblem, tracking: str) -> np.ndarray:
+    """Rows of c_k that need holding at the first waypoint only.
+
+    When no moving joint turns the tool (e.g. a PPP gantry), the tool-axis equalities are the same
+    function of the design joints at every waypoint: 2N equations of rank 2, which breaks IPOPT's
+    constraint qualification (measured: PPP stalled at max_iter). They are then imposed once.
+    """
+    if tracking != "hard":
+        return np.zeros(0, dtype=int)
+    chain = problem.chain
+    q, q_d = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design)
+    _, z_W, _, _, _ = waypoint_function(problem)(q, q_d, ca.SX.zeros(3), ca.SX.zeros(3))
+    return np.array([3, 4, 5]) if not ca.depends_on(z_W, q) else np.zeros(0, dtype=int)
