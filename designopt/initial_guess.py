@@ -76,18 +76,18 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     return Q
 
 
-def initial_guesses(problem: DesignProblem, count: int, seed: int, scale: float, mode: str = "ik"):
-    """``count`` seeded starts. Start 0 keeps the configured design; the others perturb it."""
+def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik") -> InitialGuess:
+    """Start ``index`` of a seeded multistart (seed * 1000 + index). Start 0 keeps the configured design;
+    the others perturb it. Each start depends only on (seed, index), so starts can be made in any order."""
     if mode not in INIT_MODES:
         raise ValueError(f"init must be one of {INIT_MODES}, got {mode!r}")
-    guesses = []
-    for i in range(count):
-        rng = np.random.default_rng([seed, i])
-        q_d = problem.chain.design_values if i == 0 else perturbed_design(problem, rng, scale)
-        q0 = random_configuration(problem, rng)
-        if mode == "ik":
-            Q = ik_trajectory(problem, q_d, q0)
-        else:
-            Q = np.tile(q0, (problem.toolpath.n, 1))
-        guesses.append(InitialGuess(q_d=q_d, Q=Q, seed=seed * 1000 + i))
-    return guesses
+    rng = np.random.default_rng([seed, index])
+    q_d = problem.chain.design_values if index == 0 else perturbed_design(problem, rng, scale)
+    q0 = random_configuration(problem, rng)
+    Q = ik_trajectory(problem, q_d, q0) if mode == "ik" else np.tile(q0, (problem.toolpath.n, 1))
+    return InitialGuess(q_d=q_d, Q=Q, seed=seed * 1000 + index)
+
+
+def initial_guesses(problem: DesignProblem, count: int, seed: int, scale: float, mode: str = "ik"):
+    """The first ``count`` starts of a seeded multistart."""
+    return [initial_guess(problem, i, seed, scale, mode) for i in range(count)]

@@ -15,7 +15,7 @@ import pickle
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-from designopt.initial_guess import initial_guesses
+from designopt.initial_guess import initial_guess
 from designopt.problem import DesignProblem
 from designopt.solution import Solution, solve_and_evaluate
 
@@ -45,7 +45,7 @@ def solve_start(problem: DesignProblem, transcription, settings: Multistart, ind
     """Build (or reuse) the NLP and solve start ``index`` of the multistart."""
     payload = pickle.dumps((problem, transcription))
     nlp = _built(hashlib.sha256(payload).hexdigest(), payload)
-    guess = initial_guesses(problem, index + 1, settings.seed, settings.scale, settings.init)[index]
+    guess = initial_guess(problem, index, settings.seed, settings.scale, settings.init)
     return solve_and_evaluate(problem, transcription.name, nlp.solve(guess), label)
 
 

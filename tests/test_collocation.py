@@ -128,3 +128,13 @@ def test_axis_held_once_when_no_joint_turns_the_tool():
     sol = solve_and_evaluate(problem, "to", raw)
     assert raw.success, raw.status
     assert sol.metrics.tracks
+
+
+def test_each_start_depends_only_on_seed_and_index(gantry_problem):
+    from designopt.initial_guess import initial_guess
+
+    many = initial_guesses(gantry_problem, 3, seed=7, scale=0.3, mode="constant")
+    one = initial_guess(gantry_problem, 2, seed=7, scale=0.3, mode="constant")
+    np.testing.assert_array_equal(many[2].Q, one.Q)
+    np.testing.assert_array_equal(many[2].q_d, one.q_d)
+    assert one.seed == 7002
