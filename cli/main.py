@@ -189,7 +189,7 @@ def sweep_structures(
                                                                        "(none: a LocalCluster).")] = None,
 ):
     """Solve every kinematic structure over {R, P} with min..max joints (TO + multistart), in parallel."""
-    from designopt.experiments.sweep import run_sweep
+    from designopt.experiments.sweep import best_per_dof, run_sweep
 
     if min_dof > max_dof:
         fail(f"--min-dof {min_dof} is above --max-dof {max_dof}")
@@ -219,7 +219,7 @@ def sweep_structures(
     table = pd.read_csv(run.path / "table.csv")
     solved = int(table["design_cost"].notna().sum())
     out.print(f"{len(table)} structures solved, {solved} track the path; best per number of joints:")
-    best = table.dropna(subset=["design_cost"]).sort_values("design_cost").groupby("dof").head(1).sort_values("dof")
+    best = best_per_dof(table)
     out.print(_frame_table(best[["dof", "structure", "n_prismatic", "design_cost", "tracking_starts", "starts"]],
                            "best structure per DOF"))
     out.print(f"results: {run.path}")

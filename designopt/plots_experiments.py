@@ -104,7 +104,9 @@ def structure_figures(table: pd.DataFrame, directory: Path) -> list[Path]:
             _ranked_bars(ax, rows, f"{dof}-DOF structures with three prismatic joints, ranked")
             paths += save(fig, directory, stem)
     if len(table):
-        best = table.dropna(subset=["design_cost"]).sort_values("design_cost").groupby("dof").head(1).sort_values("dof")
+        from designopt.experiments.sweep import best_per_dof
+
+        best = best_per_dof(table)
         fig, ax = plt.subplots(figsize=(5, 3.2))
         ax.semilogy(best["dof"], best["design_cost"], "o-")
         for _, r in best.iterrows():

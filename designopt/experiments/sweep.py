@@ -125,6 +125,12 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
     return run
 
 
+def best_per_dof(table: pd.DataFrame) -> pd.DataFrame:
+    """The lowest-cost tracking structure for each number of joints."""
+    tracking = table.dropna(subset=["design_cost"]).sort_values("design_cost")
+    return tracking.groupby("dof").head(1).sort_values("dof")
+
+
 def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
     """One row per structure: best tracking start (cost NaN if none tracks), starts, statuses."""
     rows = []
