@@ -125,3 +125,13 @@ def test_dask_local_cluster_gives_the_same_rows_as_loky(tmp_path):
     loky = pd.read_csv(tmp_path / "r" / "structures" / "loky" / "summary.csv")[cols].sort_values("structure")
     dask = pd.read_csv(tmp_path / "r" / "structures" / "dask" / "summary.csv")[cols].sort_values("structure")
     pd.testing.assert_frame_equal(loky.reset_index(drop=True), dask.reset_index(drop=True), rtol=1e-9)
+
+
+def test_two_sweep_configs_do_not_share_a_directory(tmp_path):
+    a = small_config(tmp_path)
+    b = tmp_path / "other.yaml"
+    b.write_text(a.read_text().replace("name: structures", "name: structures_other"))
+    assert sweep(a, tmp_path / "r", "--max-dof", "1", "--name", "x", "--jobs", "1").exit_code == 0
+    result = sweep(b, tmp_path / "r", "--max-dof", "1", "--name", "x", "--jobs", "1")
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "r" / "structures_other" / "x" / "summary.csv").is_file()

@@ -23,8 +23,6 @@ from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution
 
-EXPERIMENT = "structures"
-
 
 def enumerate_structures(min_dof: int = 1, max_dof: int = 6) -> list[str]:
     """All strings over {R, P} with min_dof..max_dof letters: by length, then R before P at each place.
@@ -100,7 +98,7 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
               max_dof: int = 6, jobs: int = -1, resume: bool = False, backend_name: str = "loky",
               scheduler: str | None = None, on_plan: Callable[[SweepPlan], None] | None = None,
               on_solution: Callable[[Solution], None] | None = None, figures: bool = True) -> RunDirectory:
-    run = RunDirectory.create(out_root, EXPERIMENT, run_name)
+    run = RunDirectory.create(out_root, cfg.name, run_name)  # results/<config name>/<run>, like every run
     if not resume and run.summary.exists():
         raise FileExistsError(f"{run.path} already holds a sweep: pass --resume to finish it, or another --name")
     run.write_config(dump_config(cfg))
@@ -112,7 +110,7 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
     if sweep_plan.tasks:
         with backend(backend_name, scheduler, jobs):
             for _, sol in solve_tasks(sweep_plan.tasks):
-                record(run, sol, EXPERIMENT, "sweep")
+                record(run, sol, cfg.name, "sweep")
                 if on_solution:
                     on_solution(sol)
     table = structure_table(pd.read_csv(run.summary))
