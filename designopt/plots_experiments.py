@@ -58,15 +58,21 @@ def optimal_robots_figure(solutions: dict, directory: Path) -> list[Path]:
 
 def waypoint_figure(table: pd.DataFrame, directory: Path) -> list[Path]:
     fig, axes = plt.subplots(1, 3, figsize=(10, 3))
-    axes[0].plot(table["waypoints"], table["design_cost"], "o-")
+    axes[0].semilogx(table["waypoints"], table["design_cost"], "o-")
     axes[0].set_ylabel("best design cost")
-    axes[1].semilogy(table["waypoints"], table["max_midpoint_error"] * 1e3, "o-", color="C1")
+    axes[1].loglog(table["waypoints"], table["max_midpoint_error"] * 1e3, "o-", color="C1")
     axes[1].axhline(1.0, ls="--", color="grey", lw=0.8)
     axes[1].set_ylabel("max position error between\nwaypoints [mm]")
     axes[2].loglog(table["waypoints"], table["median_solve_time_s"], "o-", color="C2")
     axes[2].set_ylabel("median solve time [s]")
+    from matplotlib.ticker import NullFormatter
+
     for ax in axes:
         ax.set_xlabel("waypoints N")
+        ax.set_xticks(table["waypoints"], [str(n) for n in table["waypoints"]])
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_minor_formatter(NullFormatter())
+    axes[0].set_title("(best of the multistart)", fontsize=8)
     fig.suptitle("Waypoint study (TO, design + placement)", fontsize=9)
     fig.tight_layout()
     return save(fig, directory, "waypoints")
