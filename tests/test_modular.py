@@ -134,3 +134,23 @@ def test_mixed_structure_is_a_one_line_error(tmp_path):
     result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path)])
     assert result.exit_code == 2
     assert "robot.structure" in result.output and "one joint type" in result.output
+
+
+def test_tiny_enumeration_agrees_with_a_brute_force_loop(rng):
+    """Every assignment of 3 modules to 2 links, scored by L_mod of a perturbed design: the enumeration the
+    study uses (itertools.product over assignments) finds the same best as two nested loops."""
+    small = Catalogue("R", CAT.modules[:3], CAT.w_lin, CAT.w_ang)
+    design = [(0.1, 0.45, 0.2), (0.9, 0.1, -0.1)]
+    chain = chain_with_links(design)
+
+    def score(assignment):
+        return sum(distance(design[i], small.modules[k], small) for i, k in enumerate(assignment))
+
+    enumerated = min(itertools.product(range(3), repeat=2), key=score)
+    loops = None
+    for a in range(3):
+        for b in range(3):
+            if loops is None or score((a, b)) < score(loops):
+                loops = (a, b)
+    assert enumerated == loops
+    assert list(enumerated) == nearest_modules(chain, chain.design_values, small)
