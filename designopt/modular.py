@@ -13,9 +13,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import casadi as ca
 import numpy as np
 
 from designopt.kinematics.joints import Chain
+from designopt.kinematics.transforms import is_symbolic
 
 PAPER_MODULES = (  # Table II of the paper: (theta free, d, a, alpha)
     {"d": 0.0, "a": 0.5, "alpha": 0.0},
@@ -41,9 +43,7 @@ class Catalogue:
 
 
 def _cos(x):
-    import casadi as ca
-
-    return ca.cos(x) if isinstance(x, (ca.SX, ca.MX)) else np.cos(x)
+    return ca.cos(x) if is_symbolic(x) else np.cos(x)
 
 
 def distance(link, module, catalogue: Catalogue):
@@ -61,16 +61,9 @@ def distance(link, module, catalogue: Catalogue):
 
 def link_vectors(chain: Chain, q_d, catalogue: Catalogue) -> list[list]:
     """Each link's (offset, a, alpha), taken from q_d where they are design joints, else fixed values."""
-    values = chain.link_values(np.zeros(chain.n_moving), q_d) if not _symbolic(q_d) else \
-        chain.link_values([0.0] * chain.n_moving, q_d)
+    values = chain.link_values([0.0] * chain.n_moving, q_d)  # moving values are never read here
     index = {"theta": 0, "d": 1, "a": 2, "alpha": 3}
     return [[row[index[p]] for p in catalogue.params()] for row in values]
-
-
-def _symbolic(x) -> bool:
-    import casadi as ca
-
-    return isinstance(x, (ca.SX, ca.MX))
 
 
 def modular_cost(chain: Chain, q_d, catalogue: Catalogue):

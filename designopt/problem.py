@@ -6,7 +6,7 @@ Transcriptions (TO collocation, the FK baseline) take a `DesignProblem` and neve
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -63,9 +63,6 @@ class DesignProblem:
     def regularized(self) -> list[int]:
         """Indices into q_d of the design lengths that the regularisation penalises."""
         return design_lengths(self.chain)
-
-    def with_chain(self, chain: Chain) -> DesignProblem:
-        return replace(self, chain=chain)
 
 
 def toolpath_from_config(cfg: Config, base_dir: Path) -> toolpaths.Toolpath:

@@ -12,6 +12,8 @@ import io
 import os
 from pathlib import Path
 
+import pandas as pd
+
 SUMMARY_COLUMNS = [
     "experiment", "case", "method", "structure", "dof", "n_prismatic", "n_design_joints",
     "design_cost", "max_position_error", "max_axis_error", "max_joint_step", "tracks", "best",
@@ -60,6 +62,16 @@ class RunDirectory:
             os.fsync(fd)
         finally:
             os.close(fd)
+
+    def mark_best(self, best_files: set[str]) -> pd.DataFrame:
+        """Add the ``best`` column to summary.csv, rewritten atomically (temporary file + rename) so that a
+        crash during the rewrite cannot cost a finished row."""
+        summary = pd.read_csv(self.summary)
+        summary["best"] = summary["solution_file"].isin(best_files)
+        tmp = self.summary.with_suffix(".csv.tmp")
+        summary.to_csv(tmp, index=False)
+        os.replace(tmp, self.summary)
+        return summary
 
     def finished(self) -> set[tuple[str, str, str, int]]:
         """(case, method, structure, seed) of every recorded row whose solution file exists."""

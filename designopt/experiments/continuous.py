@@ -17,7 +17,7 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.run import multistart_from_config, record
+from designopt.experiments.run import multistart_from_config, record, solution_id
 from designopt.multistart import Multistart, best_solution, solve_start
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
@@ -64,8 +64,9 @@ def _solve(task: Task) -> tuple[str, Solution]:
     return task.case, solve_start(task.problem, task.transcription, task.settings, task.index, task.case)
 
 
-def run_tasks(tasks: list[Task], jobs: int):
-    """Yield (case, solution) as tasks finish, in parallel when jobs != 1."""
+def run_tasks(tasks: list[Task], jobs: int | None):
+    """Yield (case, solution) as tasks finish, in parallel unless jobs == 1 (None: joblib's active
+    backend decides, e.g. a Dask cluster)."""
     if jobs == 1:
         for t in tasks:
             yield _solve(t)
@@ -118,19 +119,15 @@ def run_continuous(cfg: Config, base_dir: Path, out_root: Path, run_name: str | 
             tasks += [Task(case, method, problem, transcription, settings, i) for i in range(settings.count)]
     run.log(f"start continuous: {len(tasks)} solves ({len(cfg.continuous.cases)} cases x "
             f"{len(cfg.continuous.methods)} methods x {settings.count} starts)")
-    jobs = settings.jobs if settings.jobs != -1 else -1
     solutions: dict = {}
-    for case, sol in run_tasks(tasks, jobs):
+    for case, sol in run_tasks(tasks, settings.jobs):
         record(run, sol, experiment, case)
         solutions.setdefault((case, sol.method), []).append(sol)
         if on_solution:
             on_solution(case, sol)
     best = {key: best_solution(sols) for key, sols in solutions.items()}
-    summary = pd.read_csv(run.summary)
-    best_files = {f"solutions/{k[0]}-{s.method}-{s.problem.chain.structure}-s{s.raw.seed}.json"
-                  for k, s in best.items() if s is not None}
-    summary["best"] = summary["solution_file"].isin(best_files)
-    summary.to_csv(run.summary, index=False)
+    summary = run.mark_best({f"solutions/{case}-{solution_id(s)}.json" for (case, _), s in best.items()
+                             if s is not None})
     table = best_table(solutions)
     table.to_csv(run.path / "table.csv", index=False)
     for (case, method), sol in best.items():

@@ -74,10 +74,8 @@ def run_experiment(
         if on_solution:
             on_solution(sol)
     best = best_solution(solutions)
-    summary = pd.read_csv(run.summary)
+    summary = run.mark_best({f"solutions/{solution_id(best)}.json"} if best is not None else set())
     if best is not None:
-        summary["best"] = summary["seed"] == best.raw.seed
-        summary.to_csv(run.summary, index=False)
         write_solution(best, run.path / "best.json")
         run.log(f"best: seed {best.raw.seed}, design cost {best.metrics.design_cost:.6g}")
         if figures:

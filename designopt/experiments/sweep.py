@@ -9,7 +9,7 @@ so a killed sweep keeps what it finished and ``resume`` solves only the rest.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,7 +17,7 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.continuous import Task, _solve
+from designopt.experiments.continuous import Task, run_tasks
 from designopt.experiments.run import multistart_from_config, record, transcription_from_config
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
@@ -88,12 +88,6 @@ def backend(name: str, scheduler: str | None, jobs: int):
             cluster.close()
 
 
-def solve_tasks(tasks: list[Task]) -> Iterator[tuple[str, Solution]]:
-    from joblib import Parallel, delayed
-
-    yield from Parallel(return_as="generator_unordered")(delayed(_solve)(t) for t in tasks)
-
-
 def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None, min_dof: int = 1,
               max_dof: int = 6, jobs: int = -1, resume: bool = False, backend_name: str = "loky",
               scheduler: str | None = None, on_plan: Callable[[SweepPlan], None] | None = None,
@@ -109,7 +103,7 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
         on_plan(sweep_plan)
     if sweep_plan.tasks:
         with backend(backend_name, scheduler, jobs):
-            for _, sol in solve_tasks(sweep_plan.tasks):
+            for _, sol in run_tasks(sweep_plan.tasks, None):
                 record(run, sol, cfg.name, "sweep")
                 if on_solution:
                     on_solution(sol)

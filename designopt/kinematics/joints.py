@@ -120,11 +120,6 @@ class Chain:
                 return j
         raise KeyError(name)
 
-    def with_joints(self, **updates: Joint) -> Chain:
-        """A copy with the named joints replaced (names use '.' -> '__', e.g. link1__d)."""
-        by_name = {k.replace("__", "."): v for k, v in updates.items()}
-        return replace(self, joints=tuple(by_name.get(j.name, j) for j in self.joints))
-
     def with_roles(self, roles: dict[str, Role], values: dict[str, float] | None = None) -> Chain:
         """A copy in which the named joints take new roles (and optionally new values)."""
         values = values or {}
@@ -136,10 +131,6 @@ class Chain:
     @property
     def design_values(self) -> np.ndarray:
         return np.array([j.value for j in self.design])
-
-    @property
-    def moving_values(self) -> np.ndarray:
-        return np.array([j.value for j in self.moving])
 
 
 def _lifter(q_m, q_d):

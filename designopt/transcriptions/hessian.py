@@ -10,8 +10,6 @@ Hessian of the whole graph, which must colour the dense design-joint columns.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import casadi as ca
 import numpy as np
 
@@ -37,14 +35,14 @@ def assemble_hessian(
     n_g: int,
     block: ca.Function,
     y_index: np.ndarray,
-    block_inputs: Callable[[ca.MX], list],
+    block_inputs: list,
     mu_index: np.ndarray,
     constant: np.ndarray,
 ) -> ca.Function:
     """hess_lag(x, p, lam_f, lam_g) -> triu Hessian, for nlpsol's ``hess_lag`` option.
 
     ``y_index`` (N x n_y) gives the position in x of each block variable; ``mu_index`` (N x n_c) the
-    position in lam_g of each block multiplier; ``block_inputs(x)`` the block's extra inputs (mapped);
+    position in lam_g of each block multiplier; ``block_inputs`` the block's constant extra inputs (mapped);
     ``constant`` is the dense Hessian of the quadratic terms, scaled by lam_f.
     """
     N, n_y = y_index.shape
@@ -75,7 +73,7 @@ def assemble_hessian(
     Y = ca.reshape(x[ca.DM(y_index.T.ravel(order="F").tolist())], n_y, N)
     mu = ca.reshape(lam_g[ca.DM(mu_index.T.ravel(order="F").tolist())], mu_index.shape[1], N) if mu_index.size \
         else ca.MX(0, N)
-    values = block.map(N)(Y, lam_f, mu, *block_inputs(x))
+    values = block.map(N)(Y, lam_f, mu, *block_inputs)
     nz = ca.mtimes(scatter, ca.vec(values)) + lam_f * ca.DM(const_vals)
     H = ca.MX(sp, nz)
     return ca.Function("hess_lag", [x, p, lam_f, lam_g], [H], ["x", "p", "lam_f", "lam_g"], ["hess"])

@@ -66,7 +66,7 @@ class WaypointNLP:
             block = block_hessian_function(blocks.terms, n_y, n_c, blocks.compile)
             S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
             opts["hess_lag"] = assemble_hessian(self.n_variables, self.n_constraints, block, blocks.y_index,
-                                                lambda _x: [S, F], blocks.mu_index, constant)
+                                                [S, F], blocks.mu_index, constant)
         self.solver = ca.nlpsol(name, "ipopt", {"x": x, "f": objective, "g": g}, opts)
         self.build_time_s = time.perf_counter() - t_start
 
