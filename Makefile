@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup run test lint figures benchmark clean
+.PHONY: setup run test test-slow mutate lint figures benchmark clean
 
 setup: $(STAMP)
 
@@ -19,6 +19,14 @@ run: setup
 
 test: setup
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+
+# The hypothesis fuzz of every config and CSV toolpath at >= 500 cases (see docs/testing.md).
+test-slow: setup
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m slow
+
+# Plausible bugs applied one at a time in a temporary copy; every one must make a test fail.
+mutate: setup
+	$(BIN)/python tests/mutate.py
 
 lint: setup
 	$(BIN)/ruff check .

@@ -1,0 +1,137 @@
+"""Mutation check: does the test suite notice a wrong objective?
+
+Each mutation below is a plausible bug (a wrong force direction, a dropped time step, K in place of K^-1,
+...). For each, the project is copied to a temporary directory, the one line is changed there, and the
+fast tests run against the copy. A mutation is *caught* when a test fails. Run with ``make mutate``;
+exit code 1 if any mutation survives. The working tree is never modified.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# The tests that guard the objective; each mutation runs them with -x (stop at the first failure).
+TESTS = ["tests/test_objective_truth.py", "tests/test_costs_and_toolpaths.py", "tests/test_kinematics.py",
+         "tests/test_collocation.py", "tests/test_fk.py", "tests/test_cli_and_files.py"]
+
+
+@dataclass(frozen=True)
+class Mutation:
+    name: str
+    file: str
+    old: str
+    new: str
+
+
+MUTATIONS = [
+    Mutation("force along the in-plane normal instead of the tangent", "designopt/toolpaths.py",
+             "return Toolpath(kind, t, points, tangents, force * tangents)",
+             "return Toolpath(kind, t, points, tangents, force * np.column_stack("
+             "[-tangents[:, 1], tangents[:, 0], tangents[:, 2]]))"),
+    Mutation("force against the direction of travel", "designopt/toolpaths.py",
+             "return Toolpath(kind, t, points, tangents, force * tangents)",
+             "return Toolpath(kind, t, points, tangents, -force * tangents)"),
+    Mutation("dt dropped from the objective's deformation term", "designopt/transcriptions/nlp.py",
+             "phi = h * problem.deformation_weight * L_d", "phi = problem.deformation_weight * L_d"),
+    Mutation("K instead of K^-1 (problem)", "designopt/problem.py",
+             "return 1.0 / self.stiffness.diagonal(self.chain.structure)",
+             "return self.stiffness.diagonal(self.chain.structure)"),
+    Mutation("K instead of K^-1 (symbolic branch only)", "designopt/costs.py",
+             "return J @ (ca.diag(k_inv) @ (J[:3, :].T @ force_B))",
+             "return J @ (ca.diag(1.0 / k_inv) @ (J[:3, :].T @ force_B))"),
+    Mutation("revolute and prismatic stiffness swapped", "designopt/costs.py",
+             "[self.revolute if c == \"R\" else self.prismatic for c in structure]",
+             "[self.prismatic if c == \"R\" else self.revolute for c in structure]"),
+    Mutation("placement rotation order reversed", "designopt/kinematics/transforms.py",
+             "return trans(x, y, z) @ rot_z(yaw) @ rot_y(pitch) @ rot_x(roll)",
+             "return trans(x, y, z) @ rot_x(roll) @ rot_y(pitch) @ rot_z(yaw)"),
+    Mutation("tracking tolerance comparison flipped", "designopt/evaluation.py",
+             "tracks=bool(max_pos <= problem.position_tol and max_axis <= problem.axis_tol)",
+             "tracks=bool(max_pos >= problem.position_tol and max_axis >= problem.axis_tol)"),
+    Mutation("translational deflection takes the rotational rows", "designopt/costs.py",
+             "delta = delta[:3]", "delta = delta[3:]"),
+    Mutation("prismatic Jacobian column as if revolute-like", "designopt/kinematics/chain.py",
+             "lin, ang = z, 0 * z", "lin, ang = 0 * z, z"),
+    Mutation("regularisation dropped from the TO objective", "designopt/transcriptions/collocation.py",
+             "quadratic += problem.regularization * ca.sumsqr(q_d[problem.regularized])",
+             "quadratic += 0.0 * ca.sumsqr(q_d[problem.regularized])"),
+    Mutation("smoothness integral off by the interval length", "designopt/transcriptions/collocation.py",
+             "return h / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)", "return 1 / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)"),
+]
+
+
+def project_files() -> list[str]:
+    out = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=ROOT, check=True,
+                         capture_output=True, text=True).stdout
+    return [f for f in out.splitlines() if (ROOT / f).is_file()]
+
+
+def copy_project(target: Path) -> None:
+    for rel in project_files():
+        dest = target / rel
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(ROOT / rel, dest)
+
+
+def run_tests(tree: Path, cache: Path, tests: list[str]) -> tuple[bool, str]:
+    env = {**os.environ, "PYTHONPATH": str(tree), "DESIGNOPT_CACHE": str(cache), "MPLBACKEND": "Agg"}
+    # Make sure the copy, not the installed working tree, is what the tests import.
+    probe = subprocess.run([sys.executable, "-c", "import designopt, sys; print(designopt.__file__)"], cwd=tree,
+                           env=env, capture_output=True, text=True)
+    if not probe.stdout.strip().startswith(str(tree)):
+        raise RuntimeError(f"the copy is not imported: {probe.stdout.strip() or probe.stderr.strip()}")
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *tests], cwd=tree,
+                          env=env, capture_output=True, text=True)
+    lines = [line for line in proc.stdout.splitlines() if line.startswith("FAILED") or " passed" in line
+             or " failed" in line or line.startswith("ERROR")]
+    return proc.returncode == 0, "; ".join(lines[-2:])
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", help="run only mutations whose name contains this text")
+    args = parser.parse_args()
+    chosen = [m for m in MUTATIONS if not args.only or args.only in m.name]
+    with tempfile.TemporaryDirectory(prefix="designopt-mutate-") as tmp:
+        tmp = Path(tmp)
+        cache, clean = tmp / "cache", tmp / "clean"
+        copy_project(clean)
+        start = time.perf_counter()
+        ok, summary = run_tests(clean, cache, TESTS)
+        print(f"baseline (no mutation): {'green' if ok else 'RED'} in {time.perf_counter() - start:.0f} s: {summary}")
+        if not ok:
+            print("the unmutated suite fails: fix it before judging mutations")
+            return 2
+        survived = 0
+        for i, m in enumerate(chosen, 1):
+            tree = tmp / f"m{i}"
+            shutil.copytree(clean, tree)
+            path = tree / m.file
+            text = path.read_text()
+            if text.count(m.old) != 1:
+                print(f"[{i:2d}] NOT APPLIED  {m.name}: the line to mutate is not in {m.file} exactly once")
+                survived += 1
+                continue
+            path.write_text(text.replace(m.old, m.new))
+            start = time.perf_counter()
+            passed, summary = run_tests(tree, cache, TESTS)
+            survived += passed
+            verdict = "SURVIVED" if passed else "caught  "
+            print(f"[{i:2d}] {verdict} {m.name} ({time.perf_counter() - start:.0f} s): {summary}", flush=True)
+            shutil.rmtree(tree)
+        print(f"{len(chosen) - survived} of {len(chosen)} mutations caught, {survived} survived")
+    return 1 if survived else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
