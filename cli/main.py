@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import functools
 import sys
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -10,30 +12,61 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from designopt.config import ConfigError, load_config
+from designopt.config import load_config
+from designopt.errors import InputError, InputWarning
+from designopt.verify import SolutionFileError
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Design a robot and its cell in one trajectory optimization.")
-out = Console()
-err = Console(stderr=True)
+out = Console(soft_wrap=True)
+err = Console(stderr=True, soft_wrap=True)
+# Errors that are the user's input: one line, exit 2. Anything else is a bug and keeps its traceback.
+USER_ERRORS = (InputError, SolutionFileError)
+
+
+def _warn(message, category, filename, lineno, file=None, line=None) -> None:
+    if issubclass(category, InputWarning):
+        err.print(f"[yellow]warning:[/yellow] {message}", highlight=False)
+    else:
+        _show_warning(message, category, filename, lineno, file, line)
+
+
+_show_warning = warnings.showwarning
 
 
 @app.callback()
 def _group() -> None:
     """Design a robot and its cell in one trajectory optimization."""
+    warnings.showwarning = _warn
 
 
 def fail(message: str) -> None:
     """A user error: one line on stderr, exit code 2, no traceback."""
-    err.print(f"[red]error:[/red] {message}", highlight=False, soft_wrap=True)
+    err.print(f"[red]error:[/red] {message}", highlight=False)
     raise typer.Exit(code=2)
 
 
+def user_errors(command):
+    """Turn bad input found anywhere below a command into one line and exit code 2."""
+
+    @functools.wraps(command)
+    def wrapper(*args, **kwargs):
+        try:
+            return command(*args, **kwargs)
+        except USER_ERRORS as exc:
+            fail(str(exc))
+
+    return wrapper
+
+
+def show(renderable) -> None:
+    """Print a table; piped or redirected output gets its full width (no ellipses in CI logs or files)."""
+    console = out if out.is_terminal else Console(file=sys.stdout, width=1000, soft_wrap=True)
+    console.print(renderable, crop=False)
+
+
 def load(path: Path):
-    try:
-        return load_config(path)
-    except ConfigError as exc:
-        fail(str(exc))
+    return load_config(path)
 
 
 def solutions_table(solutions, title: str) -> Table:
@@ -43,13 +76,14 @@ def solutions_table(solutions, title: str) -> Table:
         table.add_column(col, justify="right")
     for s in sorted(solutions, key=lambda s: (not s.metrics.tracks, s.metrics.design_cost)):
         m, r = s.metrics, s.raw
-        table.add_row(str(r.seed), r.status, str(r.iterations), f"{r.solve_time_s:.2f}", f"{m.design_cost:.4g}",
-                      f"{m.max_position_error:.1e}", f"{m.max_axis_error:.1e}", f"{m.max_joint_step:.3f}",
+        table.add_row(str(r.seed), r.status, str(r.iterations), f"{r.solve_time_s:.2f}", f"{m.design_cost:.6g}",
+                      f"{m.max_position_error:.3e}", f"{m.max_axis_error:.3e}", f"{m.max_joint_step:.4f}",
                       "yes" if m.tracks else "no")
     return table
 
 
 @app.command()
+@user_errors
 def run(
     config: Annotated[Path, typer.Argument(help="YAML config (see configs/ and the README).")],
     out_dir: Annotated[Path, typer.Option("--out", help="Root of the results tree.")] = Path("results"),
@@ -68,8 +102,8 @@ def run(
         task = progress.add_task(f"{cfg.name}: solving {cfg.solver.multistart} starts", total=cfg.solver.multistart)
         result = run_experiment(cfg, config.parent, out_dir, name,
                                 on_solution=lambda _s: progress.advance(task), figures=not no_figures)
-    out.print(solutions_table(result.solutions, f"{cfg.name}: {cfg.robot.structure}, "
-                                                 f"stiffness {result.solutions[0].problem.stiffness}"))
+    show(solutions_table(result.solutions, f"{cfg.name}: {cfg.robot.structure}, "
+                                           f"stiffness {result.solutions[0].problem.stiffness.describe()}"))
     if result.best is None:
         out.print("[yellow]No start tracks the path within tolerance; see summary.csv for statuses.[/yellow]")
     else:
@@ -84,6 +118,32 @@ def run(
             for p in export_cell(to_dict(b), result.directory.path / "export", stem="best"):
                 out.print(f"wrote {p}")
     out.print(f"results: {result.directory.path}")
+
+
+@app.command()
+@user_errors
+def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/ and the README).")]):
+    """Validate a config and its toolpath, build the problem and its NLP, and say what a solve would be."""
+    from designopt.experiments.check import check_config
+
+    cfg = load(config)
+    s = check_config(cfg, config.parent)
+    joints = Table(title=f"{s.name}: {s.structure}, {len(s.design)} design joints, {len(s.moving)} moving, "
+                         f"{s.n_fixed} fixed")
+    for col in ("joint", "role", "start", "lower", "upper", "unit"):
+        joints.add_column(col, justify="left" if col in ("joint", "role") else "right")
+    for role, group in (("design", s.design), ("moving", s.moving)):
+        for j in group:
+            start = f"{j.value:.6g}" if role == "design" else "(trajectory)"
+            joints.add_row(j.name, role, start, f"{j.lower:.6g}", f"{j.upper:.6g}",
+                           "m" if j.kind == "length" else "rad")
+    show(joints)
+    out.print(f"toolpath: {s.toolpath_kind}, {s.waypoints} waypoints, {s.path_length_m:.6g} m long, "
+              f"force {s.force_n:.6g} N along the tangent")
+    out.print(f"stiffness: {s.stiffness.describe()}; deflection: {s.deflection}")
+    out.print(f"NLP (TO, {s.tracking} tracking, {s.kinematics} kinematics): {s.n_variables} variables, "
+              f"{s.n_constraints} constraints; built in {s.build_time_s:.2f} s")
+    out.print(f"a run solves {s.starts} start(s); nothing was solved")
 
 
 def _progress():
@@ -105,7 +165,7 @@ def _frame_table(frame, title: str) -> Table:
     for col in frame.columns:
         table.add_column(str(col), justify="right")
     for _, row in frame.iterrows():
-        table.add_row(*[f"{v:.4g}" if isinstance(v, float) else str(v) for v in row])
+        table.add_row(*[f"{v:.6g}" if isinstance(v, float) else str(v) for v in row])
     return table
 
 
@@ -115,6 +175,7 @@ NameOpt = Annotated[str | None, typer.Option("--name", help="Run name (default: 
 
 
 @app.command()
+@user_errors
 def continuous(
     config: ConfigArg = Path("configs/continuous.yaml"),
     out_dir: OutOpt = Path("results"),
@@ -137,11 +198,12 @@ def continuous(
         result = run_continuous(cfg, config.parent, out_dir, name, on_solution=done)
     cols = ["case", "method", "n_design_joints", "design_cost", "max_joint_step", "tracking_starts", "starts",
             "median_solve_time_s"]
-    out.print(_frame_table(result.table[cols], "best tracking start per case and method"))
+    show(_frame_table(result.table[cols], "best tracking start per case and method"))
     out.print(f"results: {result.directory.path}")
 
 
 @app.command()
+@user_errors
 def waypoints(
     config: ConfigArg = Path("configs/continuous.yaml"),
     out_dir: OutOpt = Path("results"),
@@ -157,24 +219,11 @@ def waypoints(
         table = run_waypoint_study(cfg, config.parent, out_dir, name,
                                    on_solution=lambda n, _s: progress.update(task, advance=1,
                                                                              description=f"waypoint study N={n}"))
-    out.print(_frame_table(table, "waypoint study (TO, design + placement)"))
-
-
-def _read_solution(path: Path) -> dict:
-    import json
-
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        fail(f"{path}: (file): no such file")
-    except (OSError, json.JSONDecodeError) as exc:
-        fail(f"{path}: (file): not a JSON solution file ({exc})")
-    if data.get("schema") != "designopt.solution/1":
-        fail(f"{path}: schema: expected 'designopt.solution/1', got {data.get('schema')!r}")
-    return data
+    show(_frame_table(table, "waypoint study (TO, design + placement)"))
 
 
 @app.command("sweep-structures")
+@user_errors
 def sweep_structures(
     config: Annotated[Path, typer.Option("--config", help="Base config (task, costs, solver).")]
     = Path("configs/structures.yaml"),
@@ -220,74 +269,71 @@ def sweep_structures(
     solved = int(table["design_cost"].notna().sum())
     out.print(f"{len(table)} structures solved, {solved} track the path; best per number of joints:")
     best = best_per_dof(table)
-    out.print(_frame_table(best[["dof", "structure", "n_prismatic", "design_cost", "tracking_starts", "starts"]],
+    show(_frame_table(best[["dof", "structure", "n_prismatic", "design_cost", "tracking_starts", "starts"]],
                            "best structure per DOF"))
     out.print(f"results: {run.path}")
 
 
 @app.command()
+@user_errors
 def modular(
     config: ConfigArg = Path("configs/modular.yaml"),
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
 ):
     """Modular design: continuous TO with L_mod, round links to modules, re-solve placement (+ FK, plain TO)."""
-    from designopt.config import ConfigError
     from designopt.experiments.modular import run_modular
 
     cfg = load(config)
     with _progress() as progress:
         task = progress.add_task("modular", total=4 * cfg.solver.multistart)
-        try:
-            result = run_modular(cfg, config.parent, out_dir, name, config_file=str(config),
-                                 on_solution=lambda case, _s: progress.update(task, advance=1, description=case))
-        except ConfigError as exc:
-            fail(str(exc))
-    out.print(_frame_table(result.table, "modular design: best tracking start per stage"))
+        result = run_modular(cfg, config.parent, out_dir, name, config_file=str(config),
+                             on_solution=lambda case, _s: progress.update(task, advance=1, description=case))
+    show(_frame_table(result.table, "modular design: best tracking start per stage"))
     out.print(f"results: {result.directory.path}")
 
 
 @app.command("modular-study")
+@user_errors
 def modular_study(
     config: ConfigArg = Path("configs/modular.yaml"),
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
 ):
     """Beyond the paper: the L_mod weight study, and every module assignment of a small catalogue."""
-    from designopt.config import ConfigError
     from designopt.experiments.modular import run_modular_study
 
     cfg = load(config)
     with _progress() as progress:
         task = progress.add_task("modular study", total=None)
-        try:
-            weights, enum = run_modular_study(cfg, config.parent, out_dir, name, config_file=str(config),
-                                              on_solution=lambda case, _s: progress.update(task, advance=1,
-                                                                                           description=case))
-        except ConfigError as exc:
-            fail(str(exc))
-    out.print(_frame_table(weights, "L_mod weight study"))
-    out.print(_frame_table(enum.head(10), "best module assignments (small catalogue)"))
+        weights, enum = run_modular_study(cfg, config.parent, out_dir, name, config_file=str(config),
+                                          on_solution=lambda case, _s: progress.update(task, advance=1,
+                                                                                       description=case))
+    show(_frame_table(weights, "L_mod weight study"))
+    show(_frame_table(enum.head(10), "best module assignments (small catalogue)"))
     picked = enum[enum["rounding_picked"]]
     if len(picked):
         out.print(f"rounding picked rank {int(picked['rank'].iloc[0])} of {len(enum)}")
 
 
 @app.command()
+@user_errors
 def export(
     solution: Annotated[Path, typer.Argument(help="A solution file (designopt.solution/1).")],
     out_dir: Annotated[Path | None, typer.Option("--out", help="Directory (default: next to the solution).")] = None,
 ):
     """Write the designed cell as URDF (robot + placed workpiece + toolpath) and the joint trajectory."""
     from designopt.export import export as export_cell
+    from designopt.verify import load_verified
 
-    data = _read_solution(solution)
+    data = load_verified(solution)
     paths = export_cell(data, out_dir or solution.parent / "export", stem=solution.stem)
     for p in paths:
         out.print(f"wrote {p}")
 
 
 @app.command()
+@user_errors
 def render(
     solution: Annotated[Path, typer.Argument(help="A solution file (designopt.solution/1).")],
     out_dir: Annotated[Path | None, typer.Option("--out", help="Directory (default: next to the solution).")] = None,
@@ -297,8 +343,9 @@ def render(
 ):
     """Draw the robot following its path (PNG + PDF), optionally animated."""
     from designopt.plots import render_animation, render_figure, save
+    from designopt.verify import load_verified
 
-    data = _read_solution(solution)
+    data = load_verified(solution)
     target = out_dir or solution.parent
     for p in save(render_figure(data, frames), target, f"{solution.stem}_render"):
         out.print(f"wrote {p}")

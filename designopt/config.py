@@ -11,22 +11,20 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator
 
+from designopt.errors import InputError
 from designopt.kinematics.joints import DH_PARAMS, PLACEMENT_PARAMS
 from designopt.kinematics.presets import PRESETS
 
 
-class ConfigError(Exception):
+class ConfigError(InputError):
     """A config problem, worded as one line naming the file, the key and the reason."""
-
-    def __init__(self, file: str | Path, key: str, reason: str):
-        self.file, self.key, self.reason = str(file), key, reason
-        super().__init__(f"{file}: {key}: {reason}")
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # NaN and inf are never meaningful here (a tolerance of .inf would make every start "track").
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 Pair = tuple[float, float]
@@ -139,7 +137,7 @@ class SolverConfig(_Strict):
     multistart: Annotated[int, Field(ge=1, le=1000)] = 4
     seed: Annotated[int, Field(ge=0)] = 0
     max_iter: Annotated[int, Field(ge=1)] = 3000
-    jobs: Annotated[int, Field(ge=-1)] = -1
+    jobs: Annotated[int, Field(ge=-1)] = -1  # -1: every core; 0 is rejected in _semantic_errors
     perturbation: Annotated[float, Field(ge=0)] = 0.3
     init: Literal["ik", "constant"] = "ik"
     compile: Literal["none", "O0", "O1", "O2"] = "O0"
@@ -195,6 +193,18 @@ class Config(_Strict):
     solver: SolverConfig = SolverConfig()
     continuous: ContinuousConfig = ContinuousConfig()
     modular: ModularConfig = ModularConfig()
+    # Where the config came from: errors found later (building the problem) name this file, and relative
+    # paths in it (a CSV toolpath) resolve against its directory.
+    _file: str = PrivateAttr("<config>")
+    _base_dir: Path = PrivateAttr(Path("."))
+
+    @property
+    def file(self) -> str:
+        return self._file
+
+    def error(self, key: str, reason: str) -> ConfigError:
+        """A ConfigError about this config's ``key``."""
+        return ConfigError(self._file, key, reason)
 
 
 def _key(loc: tuple) -> str:
@@ -225,16 +235,26 @@ def _semantic_errors(cfg: Config, base_dir: Path) -> list[tuple[str, str]]:
         errors.append(("robot.dh", f"{len(cfg.robot.dh)} rows for structure {cfg.robot.structure} of {n} links"))
     for name in ("length", "angle", "revolute", "prismatic"):
         lo, hi = getattr(cfg.robot.bounds, name)
-        if not lo < hi:
-            errors.append((f"robot.bounds.{name}", f"lower bound {lo} must be below upper bound {hi}"))
+        if not lo <= hi:
+            errors.append((f"robot.bounds.{name}", f"lower bound {lo} is above upper bound {hi}"))
     if cfg.robot.bounds.length[0] < 0:
         errors.append(("robot.bounds.length", "design lengths are >= 0 (SPEC §3); lower bound must be >= 0"))
     for k, ((lo, hi), v) in enumerate(zip(cfg.placement.box, cfg.placement.xyz, strict=True)):
         axis = "xyz"[k]
-        if not lo < hi:
-            errors.append((f"placement.box.{axis}", f"lower bound {lo} must be below upper bound {hi}"))
+        if not lo <= hi:
+            errors.append((f"placement.box.{axis}", f"lower bound {lo} is above upper bound {hi}"))
         elif not lo <= v <= hi:
             errors.append(("placement.xyz", f"{axis} = {v} lies outside the box [{lo}, {hi}]"))
+    for name, v in zip(("yaw", "pitch", "roll"), cfg.placement.ypr, strict=True):
+        if name in cfg.placement.free and not -math.pi <= v <= math.pi:
+            errors.append(("placement.ypr", f"{name} = {v} is a free placement angle and must lie in [-pi, pi]"))
+    if cfg.solver.jobs == 0:
+        errors.append(("solver.jobs", "0 workers cannot solve anything (-1: every core, or >= 1)"))
+    n_modules = len(cfg.modular.modules)
+    for k in cfg.modular.enumeration_modules:
+        if k > n_modules:
+            errors.append(("modular.enumeration_modules", f"module {k} does not exist (the catalogue has "
+                                                          f"{n_modules})"))
     if cfg.toolpath.kind == "csv":
         path = (base_dir / cfg.toolpath.file).resolve()
         if not path.is_file():
@@ -263,6 +283,7 @@ def parse_config(data: object, file: str | Path = "<config>", base_dir: Path | N
     errors = _semantic_errors(cfg, base)
     if errors:
         raise ConfigError(file, *errors[0])
+    cfg._file, cfg._base_dir = str(file), base
     return cfg
 
 

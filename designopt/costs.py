@@ -34,6 +34,12 @@ class Stiffness:
     def is_paper_model(self) -> bool:
         return self.revolute == 1.0 and self.prismatic == 1.0
 
+    def describe(self) -> str:
+        """The model in words, with units: every result states the one it used."""
+        if self.is_paper_model:
+            return "K = I (the paper's: 1 N*m/rad = 1 N/m)"
+        return f"revolute {self.revolute:g} N*m/rad, prismatic {self.prismatic:g} N/m"
+
 
 def tracking(p, z, s_B, z_target):
     """Tracking cost L_t: squared position error plus squared tool-axis error (m^2 + dimensionless)."""

@@ -15,6 +15,8 @@ from designopt import toolpaths
 from designopt.config import Config, dh_rows
 from designopt.costs import Stiffness
 from designopt.design_space import JointBounds, build_chain, design_lengths
+from designopt.errors import InputError
+from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.joints import Chain
 
 
@@ -66,15 +68,68 @@ class DesignProblem:
 
 
 def toolpath_from_config(cfg: Config, base_dir: Path) -> toolpaths.Toolpath:
+    """The config's toolpath; a path that cannot define a task is a ConfigError (or an InputError naming
+    the line of a CSV file)."""
     tp = cfg.toolpath
-    if tp.kind == "figure_eight":
-        return toolpaths.figure_eight(tp.width, tp.height, tp.waypoints, tp.force)
-    if tp.kind == "circle":
-        return toolpaths.circle(tp.radius, tp.waypoints, tp.force)
-    if tp.kind == "line":
-        return toolpaths.line(tp.length, tp.waypoints, tp.force)
-    points = toolpaths.read_csv(base_dir / tp.file)
-    return toolpaths.from_points(points, tp.waypoints, tp.force)
+    try:
+        if tp.kind == "figure_eight":
+            return toolpaths.figure_eight(tp.width, tp.height, tp.waypoints, tp.force)
+        if tp.kind == "circle":
+            return toolpaths.circle(tp.radius, tp.waypoints, tp.force)
+        if tp.kind == "line":
+            return toolpaths.line(tp.length, tp.waypoints, tp.force)
+        path = base_dir / tp.file
+        points = toolpaths.read_csv(path)
+        if tp.waypoints is None and len(points) < 3:
+            raise InputError(path, "(file)", f"{len(points)} points make {len(points)} waypoints, a path needs at "
+                                             "least 3: add points, or set toolpath.waypoints to resample")
+        return toolpaths.from_points(points, tp.waypoints, tp.force)
+    except toolpaths.ToolpathError as exc:
+        raise cfg.error("toolpath", str(exc)) from None
+
+
+def _config_key(joint_name: str) -> str:
+    """The config key a user edits to change a joint's start value ('link3.d' -> 'robot.dh[2].d')."""
+    group, param = joint_name.split(".")
+    if group == "placement":
+        return "placement.xyz" if param in "xyz" else "placement.ypr"
+    return f"robot.dh[{int(group.removeprefix('link')) - 1}].{param}"
+
+
+def check_start_values(cfg: Config, chain: Chain) -> None:
+    """Every design joint starts inside its bounds: start 0 of a multistart is the configured design, and
+    silently clipping it would make it another one."""
+    for j in chain.design:
+        if not j.lower <= j.value <= j.upper:
+            raise cfg.error(_config_key(j.name), f"start value {j.value:g} of design joint {j.name} lies outside "
+                                                 f"its bounds [{j.lower:g}, {j.upper:g}]")
+
+
+def check_standoff(cfg: Config, chain: Chain, toolpath: toolpaths.Toolpath) -> None:
+    """A keep-out radius the cell cannot satisfy is a config error, not a solve that fails.
+
+    With the placement fixed the distance of every waypoint from the base z-axis is known. With free
+    coordinates it is at most the farthest (x, y) the box allows plus the path's radius about W's origin.
+    """
+    r = cfg.placement.keep_out_radius
+    if r <= 0:
+        return
+    free = set(cfg.placement.free)
+    if not free:
+        T_BW = placement_pose(chain, np.zeros(chain.n_moving), chain.design_values)
+        s_B = toolpath.points_W @ T_BW[:3, :3].T + T_BW[:3, 3]
+        k = int(np.argmin(np.hypot(s_B[:, 0], s_B[:, 1])))
+        nearest = float(np.hypot(*s_B[k, :2]))
+        if nearest < r:
+            raise cfg.error("placement.keep_out_radius", f"the fixed placement puts waypoint {k} {nearest:.4g} m from "
+                                                         f"the base axis, inside the stand-off of {r:g} m")
+        return
+    xs = cfg.placement.box[0] if "x" in free else (cfg.placement.xyz[0],) * 2
+    ys = cfg.placement.box[1] if "y" in free else (cfg.placement.xyz[1],) * 2
+    farthest = max(np.hypot(x, y) for x in xs for y in ys) + float(np.linalg.norm(toolpath.points_W, axis=1).max())
+    if farthest < r:
+        raise cfg.error("placement.keep_out_radius", f"{r:g} m cannot be met: no waypoint can get farther than "
+                                                     f"{farthest:.4g} m from the base axis inside placement.box")
 
 
 def stiffness_from_config(cfg: Config) -> Stiffness:
@@ -103,10 +158,13 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         cfg.placement.free,
         bounds,
     )
+    check_start_values(cfg, chain)
+    toolpath = toolpath_from_config(cfg, base_dir)
+    check_standoff(cfg, chain, toolpath)
     return DesignProblem(
         name=cfg.name,
         chain=chain,
-        toolpath=toolpath_from_config(cfg, base_dir),
+        toolpath=toolpath,
         stiffness=stiffness_from_config(cfg),
         deflection=cfg.costs.deflection,
         deformation_weight=cfg.costs.deformation_weight,

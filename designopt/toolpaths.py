@@ -6,10 +6,19 @@ tangent: F = alpha * s'(t) / |s'(t)|.
 
 from __future__ import annotations
 
+import csv
+import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from designopt.errors import InputError, InputWarning
+
+
+class ToolpathError(ValueError):
+    """A toolpath that cannot define a task (its message says why)."""
 
 
 @dataclass(frozen=True)
@@ -34,8 +43,10 @@ class Toolpath:
 
 def _from_samples(kind: str, t: np.ndarray, points: np.ndarray, velocity: np.ndarray, force: float) -> Toolpath:
     speed = np.linalg.norm(velocity, axis=1, keepdims=True)
+    if not np.all(np.isfinite(points)) or not np.all(np.isfinite(velocity)):
+        raise ToolpathError(f"{kind} toolpath has a point that is not a finite number")
     if np.any(speed < 1e-12):
-        raise ValueError(f"{kind} toolpath has a waypoint with zero speed: its force direction is undefined")
+        raise ToolpathError(f"{kind} toolpath has a waypoint with zero speed: its force direction is undefined")
     tangents = velocity / speed
     return Toolpath(kind, t, points, tangents, force * tangents)
 
@@ -69,28 +80,91 @@ def line(length: float, n: int, force: float = 1.0) -> Toolpath:
 def from_points(points: np.ndarray, n: int | None = None, force: float = 1.0, kind: str = "csv") -> Toolpath:
     """A user's polyline in W, resampled by arc length to n waypoints (all of them if n is None).
 
-    Tangents are central differences of the resampled points (one-sided at the ends).
+    Tangents are central differences of the resampled points (one-sided at the ends). Where the path
+    doubles back (a zig-zag pass) the central difference vanishes; there the tangent is the direction of the
+    segment that leaves the waypoint, so the force follows the new direction of travel.
     """
     points = np.asarray(points, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3 or len(points) < 2:
-        raise ValueError("a point toolpath needs at least 2 rows of x, y, z")
+        raise ToolpathError("a point toolpath needs at least 2 rows of x, y, z")
+    if not np.all(np.isfinite(points)):
+        raise ToolpathError("a point toolpath has a coordinate that is not a finite number")
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
     if np.any(seg < 1e-12):
-        raise ValueError("a point toolpath has two identical consecutive points")
-    arc = np.concatenate([[0.0], np.cumsum(seg)]) / seg.sum()
+        raise ToolpathError("a point toolpath has two identical consecutive points")
     n = len(points) if n is None else n
+    if n < 3:
+        raise ToolpathError(f"{n} waypoints; a toolpath needs at least 3")
+    arc = np.concatenate([[0.0], np.cumsum(seg)]) / seg.sum()
     t = np.linspace(0.0, 1.0, n)
     pts = np.column_stack([np.interp(t, arc, points[:, k]) for k in range(3)])
     vel = np.gradient(pts, t, axis=0)
+    steps = np.diff(pts, axis=0) / np.diff(t)[:, None]
+    typical = np.median(np.linalg.norm(steps, axis=1))
+    for k in np.flatnonzero(np.linalg.norm(vel, axis=1) < 1e-6 * typical):
+        # a reversal: leave along the outgoing segment (the last waypoint keeps its incoming one)
+        candidates = [steps[j] for j in (k, k - 1) if 0 <= j < len(steps) and np.linalg.norm(steps[j]) > 1e-12]
+        if candidates:
+            vel[k] = candidates[0]
     return _from_samples(kind, t, pts, vel, force)
 
 
 def read_csv(path: Path) -> np.ndarray:
-    """Read x, y, z columns (metres, in W) from a CSV with a header row naming them."""
-    import pandas as pd
+    """Read x, y, z columns (metres, in W) from a CSV whose first non-empty row names them.
 
-    frame = pd.read_csv(path)
-    missing = {"x", "y", "z"} - set(frame.columns)
-    if missing:
-        raise ValueError(f"missing column(s) {', '.join(sorted(missing))}")
-    return frame[["x", "y", "z"]].to_numpy(dtype=float)
+    Bad content raises `InputError` naming the file and line. Consecutive repeated points are dropped with
+    an `InputWarning` (a CAM export often repeats the point where a segment ends and the next begins).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError:
+        raise InputError(path, "(file)", "not a text file") from None
+    except OSError as exc:
+        raise InputError(path, "(file)", f"cannot read: {exc.strerror or exc}") from None
+    reader = csv.reader(text.splitlines())
+    header, columns, points, lines = None, None, [], []
+    try:
+        for row in reader:
+            cells = [c.strip() for c in row]
+            if not any(cells):
+                continue
+            line = f"line {reader.line_num}"
+            if header is None:
+                header = [c.lower() for c in cells]
+                missing = [c for c in "xyz" if c not in header]
+                if missing:
+                    raise InputError(path, line, f"the header must name columns x, y, z (missing: "
+                                                 f"{', '.join(missing)}; found: {', '.join(cells)})")
+                columns = [header.index(c) for c in "xyz"]
+                continue
+            if len(cells) <= max(columns):
+                raise InputError(path, line, f"{len(cells)} cells, but column {header[max(columns)]} is "
+                                             f"number {max(columns) + 1} of the header")
+            values = []
+            for name, i in zip("xyz", columns, strict=True):
+                try:
+                    value = float(cells[i])
+                except ValueError:
+                    raise InputError(path, line, f"{name} = {cells[i]!r} is not a number") from None
+                if not math.isfinite(value):
+                    raise InputError(path, line, f"{name} = {cells[i]} is not a finite number")
+                values.append(value)
+            points.append(values)
+            lines.append(reader.line_num)
+    except csv.Error as exc:
+        raise InputError(path, f"line {reader.line_num}", f"malformed CSV: {exc}") from None
+    if header is None:
+        raise InputError(path, "(file)", "empty: expected a header x,y,z and at least 3 points")
+    if not points:
+        raise InputError(path, "(file)", "no points below the header")
+    points = np.array(points)
+    repeated = np.flatnonzero(np.all(np.abs(np.diff(points, axis=0)) < 1e-12, axis=1)) + 1
+    if len(points) - len(repeated) < 2:
+        raise InputError(path, "(file)", "a path needs at least 2 distinct points")
+    if len(repeated):
+        where = ", ".join(str(lines[i]) for i in repeated[:5]) + (" ..." if len(repeated) > 5 else "")
+        warnings.warn(f"{path}: line{'s' if len(repeated) > 1 else ''} {where}: repeated point dropped",
+                      InputWarning, stacklevel=2)
+        points = np.delete(points, repeated, axis=0)
+    return points

@@ -8,11 +8,109 @@ file (SPEC §7). Usable as ``python -m designopt.verify FILE...``.
 from __future__ import annotations
 
 import json
+import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+SCHEMA = "designopt.solution/1"
+
+
+class SolutionFileError(ValueError):
+    """A solution file that is malformed or does not check out: one line naming the file, key and reason."""
+
+    def __init__(self, file, key: str, reason: str):
+        self.file, self.key, self.reason = str(file), key, reason
+        super().__init__(f"{file}: {key}: {reason}")
+
+
+def _array(data: dict, key: str, shape: tuple, file) -> np.ndarray:
+    """data[key] (a dotted path) as a finite float array of the given shape (None: any length)."""
+    value = data
+    for part in key.split("."):
+        if not isinstance(value, dict) or part not in value:
+            raise SolutionFileError(file, key, "missing")
+        value = value[part]
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise SolutionFileError(file, key, "expected numbers") from None
+    if arr.ndim != len(shape) or any(s is not None and s != a for s, a in zip(shape, arr.shape, strict=True)):
+        want = " x ".join("N" if s is None else str(s) for s in shape) or "a number"
+        raise SolutionFileError(file, key, f"expected {want}, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise SolutionFileError(file, key, "contains a value that is not a finite number")
+    return arr
+
+
+def check_schema(data: object, file="<solution>") -> None:
+    """Raise SolutionFileError unless ``data`` has every field of designopt.solution/1 with the right shape."""
+    if not isinstance(data, dict):
+        raise SolutionFileError(file, "(top level)", "expected a JSON object")
+    if data.get("schema") != SCHEMA:
+        raise SolutionFileError(file, "schema", f"expected {SCHEMA!r}, got {data.get('schema')!r}")
+    structure = data.get("structure")
+    if not isinstance(structure, str) or not structure or set(structure) - {"R", "P"}:
+        raise SolutionFileError(file, "structure", f"expected a string over R and P, got {structure!r}")
+    n = len(structure)
+    dh = data.get("dh")
+    if not isinstance(dh, list) or len(dh) != n:
+        raise SolutionFileError(file, "dh", f"expected {n} rows for structure {structure}")
+    for i, (row, link_type) in enumerate(zip(dh, structure, strict=True)):
+        if not isinstance(row, dict) or row.get("type") != link_type:
+            raise SolutionFileError(file, f"dh[{i}].type", f"expected {link_type!r} (structure {structure})")
+        moving = "theta" if link_type == "R" else "d"
+        for param in ("theta", "d", "a", "alpha"):
+            value = row.get(param, "missing")
+            if param == moving:
+                if value is not None:
+                    raise SolutionFileError(file, f"dh[{i}].{param}", "the moving parameter must be null")
+            elif isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+                raise SolutionFileError(file, f"dh[{i}].{param}", f"expected a finite number, got {value!r}")
+    _array(data, "tool", (4, 4), file)
+    _array(data, "placement.xyz", (3,), file)
+    _array(data, "placement.ypr", (3,), file)
+    if np.any(_array(data, "stiffness", (n,), file) <= 0):
+        raise SolutionFileError(file, "stiffness", "every joint stiffness must be > 0")
+    if _array(data, "force_alpha", (), file) < 0:
+        raise SolutionFileError(file, "force_alpha", "must be >= 0")
+    points = _array(data, "toolpath.points_W", (None, 3), file)
+    if len(points) < 2:
+        raise SolutionFileError(file, "toolpath.points_W", "a path needs at least 2 waypoints")
+    _array(data, "toolpath.force_W", (len(points), 3), file)
+    _array(data, "q", (len(points), n), file)
+    metrics = data.get("metrics")
+    if not isinstance(metrics, dict):
+        raise SolutionFileError(file, "metrics", "missing")
+    for key in ("design_cost", "max_position_error", "max_axis_error"):
+        if _array(data, f"metrics.{key}", (), file) < 0:
+            raise SolutionFileError(file, f"metrics.{key}", "must be >= 0")
+    if not isinstance(metrics.get("tracks"), bool):
+        raise SolutionFileError(file, "metrics.tracks", f"expected true or false, got {metrics.get('tracks')!r}")
+    if metrics.get("deflection") not in ("full", "translational"):
+        raise SolutionFileError(file, "metrics.deflection", f"expected full or translational, got "
+                                                            f"{metrics.get('deflection')!r}")
+    if "tolerances" in metrics:
+        for key in ("position", "axis"):
+            if _array(data, f"metrics.tolerances.{key}", (), file) <= 0:
+                raise SolutionFileError(file, f"metrics.tolerances.{key}", "must be > 0")
+
+
+def read_solution(path) -> dict:
+    """Read a solution file and check its schema; SolutionFileError (one line) if it is not one."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise SolutionFileError(path, "(file)", "no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SolutionFileError(path, "(file)", f"cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+    except json.JSONDecodeError as exc:
+        raise SolutionFileError(path, f"line {exc.lineno}", f"not JSON: {exc.msg}") from None
+    check_schema(data, path)
+    return data
 
 
 def _dh(theta, d, a, alpha):
@@ -77,28 +175,59 @@ def recompute(data: dict, position_tol: float = 1e-3, axis_tol: float = 1e-2, de
     return Check(cost, pos_err, axis_err, pos_err <= position_tol and axis_err <= axis_tol)
 
 
-def verify_file(path: Path, rtol: float = 1e-6) -> list[str]:
-    """Problems found in one solution file (an empty list means it checks out)."""
-    data = json.loads(Path(path).read_text())
-    if data.get("schema") != "designopt.solution/1":
-        return [f"schema is {data.get('schema')!r}"]
-    check, m = recompute(data), data["metrics"]
-    problems = []
+def problems(data: dict, rtol: float = 1e-6) -> list[tuple[str, str]]:
+    """(key, reason) for every reported number that does not follow from the file's own data."""
+    found = []
+    m = data["metrics"]
+    alpha = float(data["force_alpha"])
+    norms = np.linalg.norm(np.array(data["toolpath"]["force_W"], dtype=float), axis=1)
+    if not np.allclose(norms, alpha, rtol=1e-9, atol=1e-12):
+        found.append(("toolpath.force_W", f"force magnitudes {norms.min():.6g}..{norms.max():.6g} differ from "
+                                          f"force_alpha {alpha:.6g}"))
+    check = recompute(data)
     if not np.isclose(check.design_cost, m["design_cost"], rtol=rtol, atol=0.0):
-        problems.append(f"design_cost {m['design_cost']} != recomputed {check.design_cost}")
+        found.append(("metrics.design_cost", f"{m['design_cost']} != recomputed {check.design_cost}"))
     if not np.isclose(check.max_position_error, m["max_position_error"], rtol=1e-6, atol=1e-12):
-        problems.append(f"max_position_error {m['max_position_error']} != {check.max_position_error}")
+        found.append(("metrics.max_position_error", f"{m['max_position_error']} != recomputed "
+                                                    f"{check.max_position_error}"))
     if not np.isclose(check.max_axis_error, m["max_axis_error"], rtol=1e-6, atol=1e-12):
-        problems.append(f"max_axis_error {m['max_axis_error']} != {check.max_axis_error}")
+        found.append(("metrics.max_axis_error", f"{m['max_axis_error']} != recomputed {check.max_axis_error}"))
     if check.tracks != m["tracks"]:
-        problems.append(f"tracks {m['tracks']} != recomputed {check.tracks}")
-    return problems
+        found.append(("metrics.tracks", f"{m['tracks']} != recomputed {check.tracks}"))
+    return found
+
+
+def verify_file(path: Path, rtol: float = 1e-6) -> list[str]:
+    """Problems found in one solution file (an empty list means it checks out). A malformed file raises
+    SolutionFileError."""
+    return [f"{key}: {reason}" for key, reason in problems(read_solution(path), rtol)]
+
+
+def load_verified(path) -> dict:
+    """A solution file that is well formed *and* checks out, or SolutionFileError naming the first problem:
+    export and render never draw a tampered cell."""
+    data = read_solution(path)
+    found = problems(data)
+    if found:
+        raise SolutionFileError(path, *found[0])
+    return data
+
+
+def main(argv: list[str]) -> int:
+    """Check each file; print '<file>: ok' or one line with the first problem. Exit 2 if any file fails."""
+    if not argv:
+        print("usage: python -m designopt.verify SOLUTION.json [...]", file=sys.stderr)
+        return 2
+    bad = 0
+    for arg in argv:
+        try:
+            load_verified(arg)
+            print(f"{arg}: ok")
+        except SolutionFileError as exc:
+            bad += 1
+            print(exc, file=sys.stderr)
+    return 2 if bad else 0
 
 
 if __name__ == "__main__":
-    bad = 0
-    for arg in sys.argv[1:]:
-        issues = verify_file(Path(arg))
-        bad += bool(issues)
-        print(f"{arg}: {'ok' if not issues else '; '.join(issues)}")
-    sys.exit(1 if bad else 0)
+    sys.exit(main(sys.argv[1:]))

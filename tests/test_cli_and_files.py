@@ -46,6 +46,16 @@ def test_run_writes_the_run_directory(finished_run):
     assert (summary["stiffness_revolute"] == 1.0).all()
 
 
+def test_piped_output_is_not_cut(finished_run):
+    """CliRunner's stdout is not a terminal, as in CI logs and `make run | tee`: the table prints in full."""
+    result, run = finished_run
+    assert "…" not in result.output and "..." not in result.output, result.output
+    assert "Solve_Succeeded" in result.output
+    best = pd.read_csv(run / "summary.csv").query("best")
+    # the design cost keeps six significant digits: enough to compare runs
+    assert f"{best['design_cost'].iloc[0]:.6g}" in result.output
+
+
 def test_every_solution_file_reverifies(finished_run):
     _, run = finished_run
     files = sorted((run / "solutions").glob("*.json")) + [run / "best.json"]

@@ -1,0 +1,63 @@
+"""``designopt check``: validate a config and build its problem and NLP, without solving.
+
+What a user wants to know before a long run: is the input valid, which joints are design joints, how big
+the NLP is, and which stiffness model the answer will be stated in.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from designopt.config import Config
+from designopt.costs import Stiffness
+from designopt.experiments.run import transcription_from_config
+from designopt.kinematics.joints import Joint
+from designopt.problem import problem_from_config
+
+
+@dataclass(frozen=True)
+class ProblemSummary:
+    """What a solve of the config would be. Lengths in metres, force in newtons."""
+
+    name: str
+    structure: str
+    moving: tuple[Joint, ...]
+    design: tuple[Joint, ...]
+    n_fixed: int
+    toolpath_kind: str
+    waypoints: int
+    path_length_m: float
+    force_n: float
+    stiffness: Stiffness
+    deflection: str
+    tracking: str
+    kinematics: str
+    n_variables: int
+    n_constraints: int
+    build_time_s: float
+    starts: int
+
+
+def check_config(cfg: Config, base_dir: Path) -> ProblemSummary:
+    """Build the problem and its TO NLP (interpreted: no C compile, no solve) and describe them.
+
+    Raises ConfigError / InputError on bad input, like every command that would solve it.
+    """
+    problem = problem_from_config(cfg, base_dir)
+    t0 = time.perf_counter()
+    nlp = replace(transcription_from_config(cfg), compile="none").build(problem)
+    build = time.perf_counter() - t0
+    chain, tp = problem.chain, problem.toolpath
+    return ProblemSummary(
+        name=cfg.name, structure=chain.structure, moving=chain.moving, design=chain.design,
+        n_fixed=len(chain.joints) - chain.n_moving - chain.n_design, toolpath_kind=tp.kind, waypoints=tp.n,
+        path_length_m=float(np.linalg.norm(np.diff(tp.points_W, axis=0), axis=1).sum()),
+        force_n=float(np.linalg.norm(tp.force_W, axis=1).max()), stiffness=problem.stiffness,
+        deflection=problem.deflection, tracking=cfg.solver.tracking, kinematics=cfg.solver.kinematics,
+        n_variables=nlp.n_variables, n_constraints=nlp.n_constraints, build_time_s=build,
+        starts=cfg.solver.multistart,
+    )
