@@ -90,6 +90,8 @@ def run(
     name: Annotated[str | None, typer.Option("--name", help="Run name (default: a timestamp).")] = None,
     no_figures: Annotated[bool, typer.Option("--no-figures", help="Skip the figures.")] = False,
     urdf: Annotated[bool, typer.Option("--urdf", help="Also export the best design as URDF (see export).")] = False,
+    resume: Annotated[bool, typer.Option("--resume", help="Finish the run --name: keep its finished starts, "
+                                                          "solve the rest.")] = False,
 ):
     """Solve one design problem (multistart TO) and write results/<experiment>/<run>/."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -101,7 +103,7 @@ def run(
                   TimeElapsedColumn(), console=err, transient=True) as progress:
         task = progress.add_task(f"{cfg.name}: solving {cfg.solver.multistart} starts", total=cfg.solver.multistart)
         result = run_experiment(cfg, config.parent, out_dir, name,
-                                on_solution=lambda _s: progress.advance(task), figures=not no_figures)
+                                on_solution=lambda _s: progress.advance(task), figures=not no_figures, resume=resume)
     show(solutions_table(result.solutions, f"{cfg.name}: {cfg.robot.structure}, "
                                            f"stiffness {result.solutions[0].problem.stiffness.describe()}"))
     if result.best is None:
@@ -172,6 +174,8 @@ def _frame_table(frame, title: str) -> Table:
 ConfigArg = Annotated[Path, typer.Argument(help="YAML config.")]
 OutOpt = Annotated[Path, typer.Option("--out", help="Root of the results tree.")]
 NameOpt = Annotated[str | None, typer.Option("--name", help="Run name (default: a timestamp).")]
+ResumeOpt = Annotated[bool, typer.Option("--resume", help="Finish the run --name: keep its finished solves, "
+                                                          "solve the rest.")]
 
 
 @app.command()
@@ -180,6 +184,7 @@ def continuous(
     config: ConfigArg = Path("configs/continuous.yaml"),
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
+    resume: ResumeOpt = False,
 ):
     """Continuous design problem: placement only, design only, combined x TO, FK, FK with bounded steps."""
     from designopt.experiments.continuous import run_continuous
@@ -195,7 +200,7 @@ def continuous(
             failed += not sol.metrics.tracks
             progress.update(task, advance=1, description=f"continuous: {failed} not tracking")
 
-        result = run_continuous(cfg, config.parent, out_dir, name, on_solution=done)
+        result = run_continuous(cfg, config.parent, out_dir, name, on_solution=done, resume=resume)
     cols = ["case", "method", "n_design_joints", "design_cost", "max_joint_step", "tracking_starts", "starts",
             "median_solve_time_s"]
     show(_frame_table(result.table[cols], "best tracking start per case and method"))
@@ -208,6 +213,7 @@ def waypoints(
     config: ConfigArg = Path("configs/continuous.yaml"),
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
+    resume: ResumeOpt = False,
 ):
     """Waypoint study: design cost, tracking between waypoints and solve time against N (TO, combined)."""
     from designopt.experiments.waypoints import run_waypoint_study
@@ -216,7 +222,7 @@ def waypoints(
     total = len(cfg.continuous.waypoint_study) * cfg.solver.multistart
     with _progress() as progress:
         task = progress.add_task("waypoint study", total=total)
-        table = run_waypoint_study(cfg, config.parent, out_dir, name,
+        table = run_waypoint_study(cfg, config.parent, out_dir, name, resume=resume,
                                    on_solution=lambda n, _s: progress.update(task, advance=1,
                                                                              description=f"waypoint study N={n}"))
     show(_frame_table(table, "waypoint study (TO, design + placement)"))
@@ -258,11 +264,8 @@ def sweep_structures(
             failed += not sol.metrics.tracks
             progress.update(task, advance=1, description=f"{sol.problem.chain.structure:>6}: {failed} not tracking")
 
-        try:
-            run = run_sweep(cfg, config.parent, out_dir, name, min_dof, max_dof, jobs, resume, backend, scheduler,
-                            on_plan=planned, on_solution=done)
-        except FileExistsError as exc:
-            fail(str(exc))
+        run = run_sweep(cfg, config.parent, out_dir, name, min_dof, max_dof, jobs, resume, backend, scheduler,
+                        on_plan=planned, on_solution=done)
     import pandas as pd
 
     table = pd.read_csv(run.path / "table.csv")
@@ -280,6 +283,7 @@ def modular(
     config: ConfigArg = Path("configs/modular.yaml"),
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
+    resume: ResumeOpt = False,
 ):
     """Modular design: continuous TO with L_mod, round links to modules, re-solve placement (+ FK, plain TO)."""
     from designopt.experiments.modular import run_modular
@@ -287,7 +291,7 @@ def modular(
     cfg = load(config)
     with _progress() as progress:
         task = progress.add_task("modular", total=4 * cfg.solver.multistart)
-        result = run_modular(cfg, config.parent, out_dir, name, config_file=str(config),
+        result = run_modular(cfg, config.parent, out_dir, name, config_file=str(config), resume=resume,
                              on_solution=lambda case, _s: progress.update(task, advance=1, description=case))
     show(_frame_table(result.table, "modular design: best tracking start per stage"))
     out.print(f"results: {result.directory.path}")
@@ -299,6 +303,7 @@ def modular_study(
     config: ConfigArg = Path("configs/modular.yaml"),
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
+    resume: ResumeOpt = False,
 ):
     """Beyond the paper: the L_mod weight study, and every module assignment of a small catalogue."""
     from designopt.experiments.modular import run_modular_study
@@ -306,7 +311,7 @@ def modular_study(
     cfg = load(config)
     with _progress() as progress:
         task = progress.add_task("modular study", total=None)
-        weights, enum = run_modular_study(cfg, config.parent, out_dir, name, config_file=str(config),
+        weights, enum = run_modular_study(cfg, config.parent, out_dir, name, config_file=str(config), resume=resume,
                                           on_solution=lambda case, _s: progress.update(task, advance=1,
                                                                                        description=case))
     show(_frame_table(weights, "L_mod weight study"))

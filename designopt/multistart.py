@@ -1,9 +1,9 @@
-"""Seeded multistart: solve one problem from several initial guesses in parallel (joblib).
+"""Seeded multistart: one start of one problem, solved; the best of several.
 
 Local optima are everywhere in design problems, so several starts are part of the method. Each start is
-one joblib task; results stream back as they finish so the caller can write each at once. A worker
-process builds a problem's NLP once and reuses it for every start it is given (the cache below lives in
-the worker and holds at most two built NLPs).
+one task of the experiment machinery (`designopt.experiments.tasks`), which fans them out and writes each
+as it finishes. A worker process builds a problem's NLP once and reuses it for every start it is given (the
+cache below lives in the worker and holds at most two built NLPs).
 """
 
 from __future__ import annotations
@@ -12,7 +12,6 @@ import functools
 import hashlib
 import os
 import pickle
-from collections.abc import Iterator
 from dataclasses import dataclass
 
 from designopt.initial_guess import initial_guess
@@ -47,19 +46,6 @@ def solve_start(problem: DesignProblem, transcription, settings: Multistart, ind
     nlp = _built(hashlib.sha256(payload).hexdigest(), payload)
     guess = initial_guess(problem, index, settings.seed, settings.scale, settings.init)
     return solve_and_evaluate(problem, transcription.name, nlp.solve(guess), label)
-
-
-def run_multistart(problem: DesignProblem, transcription, settings: Multistart, label: str = "") -> Iterator[Solution]:
-    """Yield one Solution per start, in the order they finish."""
-    if settings.jobs == 1 or settings.count == 1:
-        for i in range(settings.count):
-            yield solve_start(problem, transcription, settings, i, label)
-        return
-    from joblib import Parallel, delayed
-
-    n_jobs = min(settings.count, os.cpu_count() or 1) if settings.jobs == -1 else settings.jobs
-    parallel = Parallel(n_jobs=n_jobs, return_as="generator_unordered")
-    yield from parallel(delayed(solve_start)(problem, transcription, settings, i, label) for i in range(settings.count))
 
 
 def best_solution(solutions) -> Solution | None:

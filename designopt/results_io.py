@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from designopt.errors import InputError
+
 SUMMARY_COLUMNS = [
     "experiment", "case", "method", "structure", "dof", "n_prismatic", "n_design_joints",
     "design_cost", "max_position_error", "max_axis_error", "max_joint_step", "tracks", "best",
@@ -38,8 +40,20 @@ class RunDirectory:
             d.mkdir(parents=True, exist_ok=True)
 
     @classmethod
-    def create(cls, root: Path, experiment: str, name: str | None = None) -> RunDirectory:
-        return cls(Path(root) / experiment / (name or default_run_name()))
+    def create(cls, root: Path, experiment: str, name: str | None = None, resume: bool = False) -> RunDirectory:
+        """results/<experiment>/<name>. A named run that already holds results is finished with ``resume``
+        and refused without it (nothing is overwritten); an unnamed run gets a fresh timestamped name."""
+        base = Path(root) / experiment
+        if name is None:
+            if resume:
+                raise InputError(base, "--name", "--resume needs the name of the run to finish")
+            name, k = default_run_name(), 2
+            while (base / name).exists():
+                name, k = f"{default_run_name()}-{k}", k + 1
+        run = cls(base / name)
+        if not resume and run.summary.exists():
+            raise InputError(run.path, "--name", "already holds a run: pass --resume to finish it, or another --name")
+        return run
 
     @property
     def summary(self) -> Path:
@@ -73,14 +87,43 @@ class RunDirectory:
         os.replace(tmp, self.summary)
         return summary
 
-    def finished(self) -> set[tuple[str, str, str, int]]:
-        """(case, method, structure, seed) of every recorded row whose solution file exists."""
-        if not self.summary.exists():
-            return set()
+    def _read_rows(self) -> tuple[list[str], list[dict]]:
+        if not self.summary.exists() or self.summary.stat().st_size == 0:
+            return [], []
         with self.summary.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-        return {(r["case"], r["method"], r["structure"], int(r["seed"])) for r in rows
-                if r.get("solution_file") and (self.path / r["solution_file"]).exists()}
+            reader = csv.DictReader(fh)
+            return list(reader.fieldnames or []), list(reader)
+
+    def _rewrite(self, fieldnames: list[str], rows: list[dict]) -> None:
+        """Replace summary.csv atomically with these rows, cell for cell as read."""
+        tmp = self.summary.with_suffix(".csv.tmp")
+        with tmp.open("w", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=fieldnames, lineterminator="\n")
+            writer.writeheader()
+            writer.writerows(rows)
+        os.replace(tmp, self.summary)
+
+    def resume(self) -> dict[tuple[str, str, str, int], dict]:
+        """The finished solves, by (case, method, structure, seed), ready to be resumed.
+
+        A row whose solution file is gone (or a second row for the same solve) is dropped from summary.csv,
+        so the solve it stood for is done again and counted once."""
+        fieldnames, rows = self._read_rows()
+        kept: dict = {}
+        for r in rows:
+            key = (r["case"], r["method"], r["structure"], int(r["seed"]))
+            if key not in kept and r.get("solution_file") and (self.path / r["solution_file"]).is_file():
+                kept[key] = r
+        if len(kept) < len(rows):
+            self._rewrite(fieldnames, list(kept.values()))
+            self.log(f"resume: dropped {len(rows) - len(kept)} row(s) without a solution file")
+        return kept
+
+    def drop_rows(self, keys: set) -> None:
+        """Remove the rows of these (case, method, structure, seed) keys from summary.csv."""
+        fieldnames, rows = self._read_rows()
+        keep = [r for r in rows if (r["case"], r["method"], r["structure"], int(r["seed"])) not in keys]
+        self._rewrite(fieldnames, keep)
 
     def log(self, message: str) -> None:
         stamp = dt.datetime.now().isoformat(timespec="seconds")

@@ -104,6 +104,9 @@ def to_dict(sol: Solution) -> dict:
             "force_W": p.toolpath.force_W.tolist(),
         },
         "q": np.asarray(r.Q).tolist(),
+        # joint velocities dq/dt at the waypoints (TO's Hermite knots; absent for FK): with q they define
+        # the trajectory between waypoints
+        **({"v": np.asarray(r.V).tolist()} if r.V is not None else {}),
         "joint_limits": [{"name": j.name, "lower": j.lower, "upper": j.upper, "velocity_per_task_time":
                           p.joint_velocity} for j in p.chain.moving],
         "design_joints": {j.name: float(v) for j, v in zip(p.chain.design, r.q_d, strict=True)},
@@ -121,6 +124,10 @@ def to_dict(sol: Solution) -> dict:
             "min_standoff": m.min_standoff,
             "kinematic_drift": r.kinematic_drift,
             "objective": _finite(r.objective),
+            "success": r.success,
+            "build_time_s": r.build_time_s,
+            "n_variables": r.n_variables,
+            "n_constraints": r.n_constraints,
             "seed": r.seed,
             "tolerances": {"position": p.position_tol, "axis": p.axis_tol},
             "stiffness_model": {"revolute_Nm_per_rad": p.stiffness.revolute,
@@ -141,6 +148,42 @@ def write_json(data: dict, path: Path) -> None:
 def write_solution(sol: Solution, path: Path) -> None:
     write_json(to_dict(sol), path)
 
+
+
+class SolutionLoadError(ValueError):
+    """A solution file that cannot stand for a solve of the given problem (missing, malformed, other problem)."""
+
+
+def read_solution_for(problem: DesignProblem, method: str, path: Path, label: str = "") -> Solution:
+    """Load a solution this problem's solve wrote earlier (to resume a run): the design joints and the joint
+    trajectory from the file, the metrics recomputed on the problem.
+
+    Raises SolutionLoadError if the file is unreadable or does not fit the problem (other design joints,
+    waypoints or joints), so the caller solves again instead of trusting it.
+    """
+    try:
+        data = json.loads(Path(path).read_text())
+        names = [j.name for j in problem.chain.design]
+        q_d = np.array([data["design_joints"][n] for n in names], dtype=float)
+        Q = np.array(data["q"], dtype=float)
+        V = np.array(data["v"], dtype=float) if "v" in data else None
+        m = data["metrics"]
+        if set(data["design_joints"]) != set(names) or Q.shape != (problem.toolpath.n, problem.chain.n_moving):
+            raise SolutionLoadError(f"{path}: written for another problem")
+        if method == "to" and V is None:
+            raise SolutionLoadError(f"{path}: no joint velocities (written before they were stored)")
+        objective = m.get("objective")
+        raw = RawResult(q_d=q_d, Q=Q, V=V, status=str(m["status"]), success=bool(m.get("success", False)),
+                        iterations=int(m["iterations"]), solve_time_s=float(m["solve_time_s"]),
+                        build_time_s=float(m.get("build_time_s", 0.0)),
+                        objective=float("nan") if objective is None else float(objective),
+                        n_variables=int(m.get("n_variables", 0)), n_constraints=int(m.get("n_constraints", 0)),
+                        seed=int(m["seed"]), kinematic_drift=float(m.get("kinematic_drift", 0.0)))
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        if isinstance(exc, SolutionLoadError):
+            raise
+        raise SolutionLoadError(f"{path}: {exc}") from None
+    return Solution(problem, method, raw, evaluate(problem, q_d, Q), label)
 
 
 def chain_from_file(data: dict) -> Chain:

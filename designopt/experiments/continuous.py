@@ -17,9 +17,10 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.run import multistart_from_config, record, solution_id
-from designopt.multistart import Multistart, best_solution, solve_start
-from designopt.problem import DesignProblem, problem_from_config
+from designopt.experiments.run import best_of, multistart_from_config
+from designopt.experiments.tasks import multistart_tasks, solve_tasks
+from designopt.multistart import best_solution
+from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
 from designopt.transcriptions import transcription_named
@@ -48,32 +49,6 @@ def method_transcription(cfg: Config, method: str):
     if method == "to":
         options.update(kinematics=s.kinematics, tracking=s.tracking, degree=s.degree)
     return transcription_named(method, **options)
-
-
-@dataclass(frozen=True)
-class Task:
-    case: str
-    method: str
-    problem: DesignProblem
-    transcription: object
-    settings: Multistart
-    index: int
-
-
-def _solve(task: Task) -> tuple[str, Solution]:
-    return task.case, solve_start(task.problem, task.transcription, task.settings, task.index, task.case)
-
-
-def run_tasks(tasks: list[Task], jobs: int | None):
-    """Yield (case, solution) as tasks finish, in parallel unless jobs == 1 (None: joblib's active
-    backend decides, e.g. a Dask cluster)."""
-    if jobs == 1:
-        for t in tasks:
-            yield _solve(t)
-        return
-    from joblib import Parallel, delayed
-
-    yield from Parallel(n_jobs=jobs, return_as="generator_unordered")(delayed(_solve)(t) for t in tasks)
 
 
 @dataclass(frozen=True)
@@ -107,28 +82,26 @@ def best_table(solutions: dict) -> pd.DataFrame:
 
 def run_continuous(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
                    on_solution: Callable[[str, Solution], None] | None = None, figures: bool = True,
-                   experiment: str = "continuous") -> ContinuousResult:
-    run = RunDirectory.create(out_root, experiment, run_name)
+                   experiment: str = "continuous", resume: bool = False) -> ContinuousResult:
+    run = RunDirectory.create(out_root, experiment, run_name, resume)
     run.write_config(dump_config(cfg))
     settings = multistart_from_config(cfg)
     tasks = []
     for case in cfg.continuous.cases:
         problem = problem_from_config(case_config(cfg, case), base_dir)
         for method in cfg.continuous.methods:
-            transcription = method_transcription(cfg, method)
-            tasks += [Task(case, method, problem, transcription, settings, i) for i in range(settings.count)]
+            tasks += multistart_tasks(case, method, problem, method_transcription(cfg, method), settings)
     run.log(f"start continuous: {len(tasks)} solves ({len(cfg.continuous.cases)} cases x "
             f"{len(cfg.continuous.methods)} methods x {settings.count} starts)")
-    solutions: dict = {}
-    for case, sol in run_tasks(tasks, settings.jobs):
-        record(run, sol, experiment, case)
-        solutions.setdefault((case, sol.method), []).append(sol)
-        if on_solution:
-            on_solution(case, sol)
-    best = {key: best_solution(sols) for key, sols in solutions.items()}
-    summary = run.mark_best({f"solutions/{case}-{solution_id(s)}.json" for (case, _), s in best.items()
-                             if s is not None})
-    table = best_table(solutions)
+    done = solve_tasks(run, tasks, experiment, settings.jobs, resume,
+                       on_solution=(lambda t, sol: on_solution(t.case, sol)) if on_solution else None)
+    groups: dict = {}
+    for task, sol in done:
+        groups.setdefault((task.case, task.method), []).append((task, sol))
+    best_pairs = {key: best_of(pairs) for key, pairs in groups.items()}
+    best = {key: sol for key, (_, sol) in best_pairs.items()}
+    summary = run.mark_best({t.file_name for t, s in best_pairs.values() if s is not None})
+    table = best_table({key: [sol for _, sol in pairs] for key, pairs in groups.items()})
     table.to_csv(run.path / "table.csv", index=False)
     for (case, method), sol in best.items():
         if sol is not None:

@@ -21,10 +21,11 @@ import pandas as pd
 from designopt.config import Config, ConfigError, dump_config
 from designopt.evaluation import evaluate
 from designopt.experiments.continuous import case_config, method_transcription
-from designopt.experiments.run import multistart_from_config, record, transcription_from_config
+from designopt.experiments.run import multistart_from_config, transcription_from_config
+from designopt.experiments.tasks import Task, multistart_tasks, record, solve_tasks
 from designopt.kinematics.joints import Role
 from designopt.modular import Catalogue, check_catalogue, link_vectors, modular_cost, nearest_modules
-from designopt.multistart import best_solution, run_multistart
+from designopt.multistart import best_solution
 from designopt.problem import DesignCost, DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
@@ -77,14 +78,12 @@ class ModularResult:
     assignment: list[int]
 
 
-def _stage(run, problem, transcription, settings, case, on_solution) -> Solution | None:
-    sols = []
-    for sol in run_multistart(problem, transcription, settings, case):
-        record(run, sol, "modular", case)
-        sols.append(sol)
-        if on_solution:
-            on_solution(case, sol)
-    return best_solution(sols)
+def _stage(run, problem, transcription, settings, case, on_solution, resume) -> Solution | None:
+    """One stage: a multistart of one problem, written (and resumed) like every experiment."""
+    tasks = multistart_tasks(case, transcription.name, problem, transcription, settings)
+    done = solve_tasks(run, tasks, "modular", settings.jobs, resume,
+                       on_solution=(lambda t, sol: on_solution(t.case, sol)) if on_solution else None)
+    return best_solution([sol for _, sol in done])
 
 
 @dataclass(frozen=True)
@@ -98,33 +97,36 @@ class _Setup:
 
 
 def _setup(cfg: Config, base_dir: Path, out_root: Path, experiment: str, run_name: str | None,
-           config_file: str) -> _Setup:
+           config_file: str, resume: bool) -> _Setup:
     """Catalogue (checked against the structure), run directory and the combined design + placement problem."""
     catalogue = catalogue_from_config(cfg)
     try:
         check_catalogue(cfg.robot.structure, catalogue)
     except ValueError as exc:
         raise ConfigError(config_file, "robot.structure", str(exc)) from None
-    run = RunDirectory.create(out_root, experiment, run_name)
-    run.write_config(dump_config(cfg))
     combined = case_config(cfg, "combined")
-    return _Setup(catalogue, run, multistart_from_config(cfg), combined, problem_from_config(combined, base_dir),
-                  transcription_from_config(combined))
+    base = problem_from_config(combined, base_dir)
+    run = RunDirectory.create(out_root, experiment, run_name, resume)
+    run.write_config(dump_config(cfg))
+    return _Setup(catalogue, run, multistart_from_config(cfg), combined, base, transcription_from_config(combined))
 
 
 def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
                 on_solution: Callable[[str, Solution], None] | None = None, figures: bool = True,
-                config_file: str = "<config>") -> ModularResult:
-    s = _setup(cfg, base_dir, out_root, "modular", run_name, config_file)
+                config_file: str = "<config>", resume: bool = False) -> ModularResult:
+    s = _setup(cfg, base_dir, out_root, "modular", run_name, config_file, resume)
     catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
-    best = {"continuous": _stage(run, base, to, settings, "continuous", on_solution)}
-    best["fk"] = _stage(run, base, method_transcription(combined_cfg, "fk"), settings, "fk", on_solution)
+    best = {"continuous": _stage(run, base, to, settings, "continuous", on_solution, resume)}
+    best["fk"] = _stage(run, base, method_transcription(combined_cfg, "fk"), settings, "fk", on_solution, resume)
     continuous, assignment, modular = _round_and_resolve(run, base, to, settings, catalogue, cfg.modular.weight, "",
-                                                         on_solution)
+                                                         on_solution, resume)
     best["continuous_modular"], best["modular"] = continuous, modular
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
-        record(run, best["rounded"], "modular", "rounded")
+        # not a solve: derived from the stage-2 best, so it is recorded once and recomputed on resume
+        rounded_task = Task("rounded", "rounded", base, None, settings, continuous.raw.seed - settings.seed * 1000)
+        if not resume or rounded_task.key not in run.resume():
+            record(run, rounded_task, best["rounded"], "modular")
         run.log(f"modules per link: {[k + 1 for k in assignment]}")
     rows = []
     for stage in STAGES:
@@ -147,33 +149,34 @@ def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | Non
     return ModularResult(run, table, assignment)
 
 
-def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, on_solution):
+def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, on_solution, resume):
     """Stages 2-4 for one L_mod weight; returns (continuous best, assignment, modular best)."""
     continuous = _stage(run, with_modular_cost(base, catalogue, weight), to, settings, f"{tag}continuous_modular",
-                        on_solution)
+                        on_solution, resume)
     if continuous is None:
         return None, [], None
     assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)
     placement = {j.name: float(v) for j, v in zip(base.chain.design, continuous.raw.q_d, strict=True)
                  if j.name.startswith("placement.")}
     modular = _stage(run, fix_modules(base, assignment, catalogue, placement), to, settings, f"{tag}modular",
-                     on_solution)
+                     on_solution, resume)
     return continuous, assignment, modular
 
 
 def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
                       on_solution: Callable[[str, Solution], None] | None = None,
-                      config_file: str = "<config>") -> tuple[pd.DataFrame, pd.DataFrame]:
+                      config_file: str = "<config>", resume: bool = False) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Beyond the paper: (a) how the L_mod weight changes the result; (b) on a small catalogue where every
     assignment can be solved, how far rounding lands from the best assignment."""
     import itertools
 
-    s = _setup(cfg, base_dir, out_root, "modular_study", run_name, config_file)
+    s = _setup(cfg, base_dir, out_root, "modular_study", run_name, config_file, resume)
     catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
 
     weights = []
     for w in cfg.modular.weight_study:
-        cont, assignment, mod = _round_and_resolve(run, base, to, settings, catalogue, w, f"w{w:g}-", on_solution)
+        cont, assignment, mod = _round_and_resolve(run, base, to, settings, catalogue, w, f"w{w:g}-", on_solution,
+                                                   resume)
         weights.append({"weight": w, "continuous_cost": cont.metrics.design_cost if cont else np.nan,
                         "L_mod": modular_cost(base.chain, cont.raw.q_d, catalogue) if cont else np.nan,
                         "modules": " ".join(f"m{k + 1}" for k in assignment),
@@ -189,12 +192,12 @@ def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str
     small_base = problem_from_config(small_cfg, base_dir)
     small_to = transcription_from_config(small_cfg)
     _, rounded_assignment, rounded_best = _round_and_resolve(run, small_base, small_to, settings, small,
-                                                             cfg.modular.weight, "enum-", on_solution)
+                                                             cfg.modular.weight, "enum-", on_solution, resume)
     placement = {j.name: j.value for j in small_base.chain.design if j.name.startswith("placement.")}
     rows = []
     for assignment in itertools.product(range(len(subset)), repeat=small_base.chain.n_links):
         best = _stage(run, fix_modules(small_base, list(assignment), small, placement), small_to, settings,
-                      "enum-" + "".join(str(subset[k] + 1) for k in assignment), on_solution)
+                      "enum-" + "".join(str(subset[k] + 1) for k in assignment), on_solution, resume)
         rows.append({"assignment": " ".join(f"m{subset[k] + 1}" for k in assignment),
                      "design_cost": best.metrics.design_cost if best else np.nan,
                      "rounding_picked": list(assignment) == rounded_assignment})

@@ -9,7 +9,8 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.multistart import Multistart, best_solution, run_multistart
+from designopt.experiments.tasks import multistart_tasks, solve_tasks
+from designopt.multistart import Multistart, best_solution
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
@@ -37,21 +38,6 @@ def multistart_from_config(cfg: Config) -> Multistart:
     return Multistart(count=s.multistart, seed=s.seed, scale=s.perturbation, init=s.init, jobs=s.jobs)
 
 
-def solution_id(sol: Solution) -> str:
-    return f"{sol.method}-{sol.problem.chain.structure}-s{sol.raw.seed}"
-
-
-def record(run: RunDirectory, sol: Solution, experiment: str, case: str) -> str:
-    """Write one solution file and its summary row; return the file name."""
-    name = f"{solution_id(sol)}.json" if not case else f"{case}-{solution_id(sol)}.json"
-    write_solution(sol, run.solutions / name)
-    run.append_row({"experiment": experiment, "case": case, **sol.row(),
-                    "solution_file": f"solutions/{name}"})
-    run.log(f"{case or 'run'} {sol.method} seed={sol.raw.seed} status={sol.raw.status} "
-            f"iter={sol.raw.iterations} cost={sol.metrics.design_cost:.6g} tracks={sol.metrics.tracks}")
-    return name
-
-
 def run_experiment(
     cfg: Config,
     base_dir: Path,
@@ -59,22 +45,22 @@ def run_experiment(
     run_name: str | None = None,
     on_solution: Callable[[Solution], None] | None = None,
     figures: bool = True,
+    resume: bool = False,
 ) -> RunResult:
-    """Solve the config's problem with multistart TO and write the run directory."""
+    """Solve the config's problem with multistart TO and write the run directory (``resume``: finish the
+    named run, solving only the starts it has no solution for)."""
     problem = problem_from_config(cfg, base_dir)
-    run = RunDirectory.create(out_root, cfg.name, run_name)
+    run = RunDirectory.create(out_root, cfg.name, run_name, resume)
     run.write_config(dump_config(cfg))
     run.log(f"start {cfg.name}: structure {cfg.robot.structure}, {problem.chain.n_design} design joints, "
             f"{problem.toolpath.n} waypoints, {cfg.solver.multistart} starts")
-    transcription = transcription_from_config(cfg)
-    solutions = []
-    for sol in run_multistart(problem, transcription, multistart_from_config(cfg)):
-        record(run, sol, cfg.name, "")
-        solutions.append(sol)
-        if on_solution:
-            on_solution(sol)
-    best = best_solution(solutions)
-    summary = run.mark_best({f"solutions/{solution_id(best)}.json"} if best is not None else set())
+    settings = multistart_from_config(cfg)
+    tasks = multistart_tasks("", "to", problem, transcription_from_config(cfg), settings)
+    done = solve_tasks(run, tasks, cfg.name, settings.jobs, resume,
+                       on_solution=(lambda _t, sol: on_solution(sol)) if on_solution else None)
+    solutions = [sol for _, sol in done]
+    best_task, best = best_of(done)
+    summary = run.mark_best({best_task.file_name} if best is not None else set())
     if best is not None:
         write_solution(best, run.path / "best.json")
         run.log(f"best: seed {best.raw.seed}, design cost {best.metrics.design_cost:.6g}")
@@ -87,4 +73,10 @@ def run_experiment(
     return RunResult(run, solutions, best, summary)
 
 
-__all__ = ["RunResult", "run_experiment", "transcription_from_config", "multistart_from_config"]
+def best_of(done: list) -> tuple:
+    """(task, solution) of the tracking solution with the lowest design cost, or (None, None)."""
+    best = best_solution([sol for _, sol in done])
+    return next(((t, s) for t, s in done if s is best), (None, None))
+
+
+__all__ = ["RunResult", "run_experiment", "transcription_from_config", "multistart_from_config", "best_of"]

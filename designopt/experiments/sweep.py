@@ -17,8 +17,8 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.continuous import Task, run_tasks
-from designopt.experiments.run import multistart_from_config, record, transcription_from_config
+from designopt.experiments.run import multistart_from_config, transcription_from_config
+from designopt.experiments.tasks import Task, multistart_tasks, solve_tasks
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution
@@ -44,19 +44,15 @@ class SweepPlan:
 
 
 def plan(cfg: Config, base_dir: Path, structures: list[str], done: set) -> SweepPlan:
+    """Every (structure, start) task of the sweep; ``tasks`` are those not in ``done`` (finished keys)."""
     settings = multistart_from_config(cfg)
-    tasks, skipped = [], 0
+    tasks = []
     for structure in structures:
         c = structure_config(cfg, structure)
-        problem = problem_from_config(c, base_dir)
-        transcription = transcription_from_config(c)
-        for i in range(settings.count):
-            seed = settings.seed * 1000 + i
-            if ("sweep", "to", structure, seed) in done:
-                skipped += 1
-                continue
-            tasks.append(Task("sweep", "to", problem, transcription, settings, i))
-    return SweepPlan(structures, tasks, skipped)
+        tasks += multistart_tasks("sweep", "to", problem_from_config(c, base_dir), transcription_from_config(c),
+                                  settings)
+    todo = [t for t in tasks if t.key not in done]
+    return SweepPlan(structures, todo, len(tasks) - len(todo))
 
 
 @contextmanager
@@ -92,21 +88,18 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
               max_dof: int = 6, jobs: int = -1, resume: bool = False, backend_name: str = "loky",
               scheduler: str | None = None, on_plan: Callable[[SweepPlan], None] | None = None,
               on_solution: Callable[[Solution], None] | None = None, figures: bool = True) -> RunDirectory:
-    run = RunDirectory.create(out_root, cfg.name, run_name)  # results/<config name>/<run>, like every run
-    if not resume and run.summary.exists():
-        raise FileExistsError(f"{run.path} already holds a sweep: pass --resume to finish it, or another --name")
+    run = RunDirectory.create(out_root, cfg.name, run_name, resume)  # results/<config name>/<run>, like every run
     run.write_config(dump_config(cfg))
-    sweep_plan = plan(cfg, base_dir, enumerate_structures(min_dof, max_dof), run.finished() if resume else set())
+    sweep_plan = plan(cfg, base_dir, enumerate_structures(min_dof, max_dof), set(run.resume()) if resume else set())
     run.log(f"sweep {min_dof}..{max_dof} DOF: {len(sweep_plan.structures)} structures, {len(sweep_plan.tasks)} "
             f"solves to do, {sweep_plan.skipped} already done")
     if on_plan:
         on_plan(sweep_plan)
     if sweep_plan.tasks:
         with backend(backend_name, scheduler, jobs):
-            for _, sol in run_tasks(sweep_plan.tasks, None):
-                record(run, sol, cfg.name, "sweep")
-                if on_solution:
-                    on_solution(sol)
+            # the plan already left out finished solves; their rows stay, and the table reads them
+            solve_tasks(run, sweep_plan.tasks, cfg.name, jobs=None,
+                        on_solution=(lambda _t, sol: on_solution(sol)) if on_solution else None)
     table = structure_table(pd.read_csv(run.summary))
     table.to_csv(run.path / "table.csv", index=False)
     if figures:

@@ -15,9 +15,10 @@ import pandas as pd
 
 from designopt.config import Config, dump_config
 from designopt.experiments.continuous import case_config
-from designopt.experiments.run import multistart_from_config, record, transcription_from_config
+from designopt.experiments.run import multistart_from_config, transcription_from_config
+from designopt.experiments.tasks import multistart_tasks, solve_tasks
 from designopt.kinematics.chain import placement_pose, tool_pose
-from designopt.multistart import best_solution, run_multistart
+from designopt.multistart import best_solution
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution
@@ -42,20 +43,18 @@ def midpoint_errors(sol: Solution, cfg: Config, base_dir: Path) -> np.ndarray:
 
 def run_waypoint_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
                        on_solution: Callable[[int, Solution], None] | None = None,
-                       figures: bool = True) -> pd.DataFrame:
-    run = RunDirectory.create(out_root, "waypoints", run_name)
+                       figures: bool = True, resume: bool = False) -> pd.DataFrame:
+    run = RunDirectory.create(out_root, "waypoints", run_name, resume)
     run.write_config(dump_config(cfg))
     base = case_config(cfg, "combined")
     rows = []
     for n in cfg.continuous.waypoint_study:
         c = base.model_copy(update={"toolpath": base.toolpath.model_copy(update={"waypoints": n})})
-        problem = problem_from_config(c, base_dir)
-        sols = []
-        for sol in run_multistart(problem, transcription_from_config(c), multistart_from_config(c)):
-            record(run, sol, "waypoints", f"N{n}")
-            sols.append(sol)
-            if on_solution:
-                on_solution(n, sol)
+        problem, settings = problem_from_config(c, base_dir), multistart_from_config(c)
+        tasks = multistart_tasks(f"N{n}", "to", problem, transcription_from_config(c), settings)
+        done = solve_tasks(run, tasks, "waypoints", settings.jobs, resume,
+                           on_solution=(lambda _t, sol, n=n: on_solution(n, sol)) if on_solution else None)
+        sols = [sol for _, sol in done]
         best = best_solution(sols)
         mid = midpoint_errors(best, c, base_dir) if best else np.array([np.nan])
         rows.append({

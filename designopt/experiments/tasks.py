@@ -1,0 +1,107 @@
+"""The one experiment machinery: tasks (one seeded start of one problem), fanned out, written as they finish,
+and resumed.
+
+Every experiment -- a run's multistart, the continuous comparison, the waypoint study, the modular stages
+and the structure sweep -- is a list of `Task`s handed to `solve_tasks`. Each finished solve is written at
+once (its solution file atomically, then its summary row), so a killed run keeps all it finished; with
+``resume`` the tasks whose row and file exist are loaded instead of solved.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+
+from designopt.multistart import Multistart, solve_start
+from designopt.problem import DesignProblem
+from designopt.results_io import RunDirectory
+from designopt.solution import Solution, SolutionLoadError, read_solution_for, write_solution
+
+
+@dataclass(frozen=True)
+class Task:
+    """Start ``index`` of a seeded multistart of ``problem`` with ``transcription``, labelled ``case``."""
+
+    case: str
+    method: str
+    problem: DesignProblem
+    transcription: object
+    settings: Multistart
+    index: int
+
+    @property
+    def seed(self) -> int:
+        return self.settings.seed * 1000 + self.index
+
+    @property
+    def key(self) -> tuple[str, str, str, int]:
+        """(case, method, structure, seed): what identifies a solve in summary.csv."""
+        return self.case, self.method, self.problem.chain.structure, self.seed
+
+    @property
+    def file_name(self) -> str:
+        stem = f"{self.method}-{self.problem.chain.structure}-s{self.seed}"
+        return f"solutions/{self.case}-{stem}.json" if self.case else f"solutions/{stem}.json"
+
+
+def multistart_tasks(case: str, method: str, problem: DesignProblem, transcription, settings: Multistart) -> list[Task]:
+    return [Task(case, method, problem, transcription, settings, i) for i in range(settings.count)]
+
+
+def _solve(task: Task) -> tuple[Task, Solution]:
+    return task, solve_start(task.problem, task.transcription, task.settings, task.index, task.case)
+
+
+def fan_out(tasks: list[Task], jobs: int | None) -> Iterator[tuple[Task, Solution]]:
+    """Yield (task, solution) as tasks finish: in this process if jobs == 1, else joblib processes (jobs = -1:
+    every core; None: joblib's active backend decides, e.g. a Dask cluster)."""
+    if jobs == 1 or len(tasks) <= 1:
+        for t in tasks:
+            yield _solve(t)
+        return
+    from joblib import Parallel, delayed
+
+    yield from Parallel(n_jobs=jobs, return_as="generator_unordered")(delayed(_solve)(t) for t in tasks)
+
+
+def record(run: RunDirectory, task: Task, sol: Solution, experiment: str) -> None:
+    """Write one solution file (atomically), then its summary row: a row always has its file."""
+    write_solution(sol, run.path / task.file_name)
+    run.append_row({"experiment": experiment, "case": task.case, **sol.row(), "solution_file": task.file_name})
+    run.log(f"{task.case or 'run'} {sol.method} seed={sol.raw.seed} status={sol.raw.status} "
+            f"iter={sol.raw.iterations} cost={sol.metrics.design_cost:.6g} tracks={sol.metrics.tracks}")
+
+
+def solve_tasks(run: RunDirectory, tasks: list[Task], experiment: str, jobs: int | None = -1,
+                resume: bool = False, on_solution: Callable[[Task, Solution], None] | None = None,
+                load_finished: bool = True) -> list[tuple[Task, Solution]]:
+    """Solve every task, writing each as it finishes; return (task, solution) for all of them.
+
+    With ``resume``, a task whose summary row and solution file exist is not solved again: its solution is
+    loaded from the file (or skipped when ``load_finished`` is False, for sweeps that only need the table).
+    A row whose file is gone or unreadable is dropped from summary.csv and solved again, so no solve is
+    counted twice.
+    """
+    finished = run.resume() if resume else {}
+    results, todo = [], []
+    for task in tasks:
+        row = finished.get(task.key)
+        if row is None:
+            todo.append(task)
+            continue
+        if not load_finished:
+            continue
+        try:
+            results.append((task, read_solution_for(task.problem, task.method, run.path / row["solution_file"],
+                                                    task.case)))
+        except SolutionLoadError:
+            run.drop_rows({task.key})
+            todo.append(task)
+    if finished:
+        run.log(f"resume: {len(tasks) - len(todo)} solves already done, {len(todo)} to do")
+    for task, sol in fan_out(todo, jobs):
+        record(run, task, sol, experiment)
+        results.append((task, sol))
+        if on_solution:
+            on_solution(task, sol)
+    return results

@@ -1,0 +1,138 @@
+"""Kill and resume, one test per command family: `run`, `continuous`, `waypoints`, `modular` (the sweep's is in
+test_sweep.py). A run SIGKILLed part-way keeps every finished solve; `--resume` with the same `--name` solves
+only the missing ones; a row whose solution file is gone is solved again and counted once."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from cli.main import app
+from designopt.verify import verify_file
+
+ROOT = Path(__file__).resolve().parent.parent
+KEY = ["case", "method", "structure", "seed"]
+runner = CliRunner()
+
+SMALL = {
+    "toolpath": {"kind": "figure_eight", "width": 0.6, "height": 0.3, "waypoints": 12},
+    "placement": {"xyz": [0.45, 0.0, -0.2]},
+    "solver": {"multistart": 3, "max_iter": 300, "jobs": 1},
+}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def shared_cache(tmp_path_factory):
+    os.environ["DESIGNOPT_CACHE"] = str(tmp_path_factory.mktemp("cache"))
+
+
+def read_summary(path: Path) -> pd.DataFrame:
+    return pd.read_csv(path, dtype={"case": str}, keep_default_na=False, na_values={"case": []})
+
+
+def kill_part_way(args: list[str], summary: Path, timeout: float = 240) -> pd.DataFrame:
+    """Start `designopt ARGS` in a subprocess, SIGKILL it once its first solve is written, return the rows."""
+    proc = subprocess.Popen([sys.executable, "-m", "cli.main", *args], cwd=ROOT, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + timeout
+    while time.time() < deadline and proc.poll() is None:
+        if summary.exists() and len(summary.read_text().splitlines()) >= 2:  # header + one row
+            break
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    return read_summary(summary)
+
+
+def check_resumed(run: Path, before: pd.DataFrame, expected: set, result) -> pd.DataFrame:
+    assert result.exit_code == 0, result.output
+    after = read_summary(run / "summary.csv")
+    keys = list(after[KEY].itertuples(index=False, name=None))
+    assert len(keys) == len(set(keys)), "a solve is counted twice"
+    assert set(keys) == expected, "a solve is missing"
+    # The first finished solve lost its file before the resume: it was solved again (one row, file back).
+    lost = tuple(before[KEY].iloc[0])
+    assert (run / before["solution_file"].iloc[0]).is_file()
+    # Every other finished solve was kept as it was, not solved again.
+    merged = before.iloc[1:].merge(after, on=KEY, suffixes=("_before", "_after"))
+    assert len(merged) == len(before) - 1
+    assert (merged["design_cost_before"] == merged["design_cost_after"]).all()
+    assert (merged["solve_time_s_before"] == merged["solve_time_s_after"]).all()
+    assert lost in set(keys)
+    for f in after["solution_file"]:
+        assert verify_file(run / f) == [], f
+    return after
+
+
+def _setup(tmp_path, extra=None):
+    cfg = {**SMALL, **(extra or {})}
+    config = tmp_path / "c.yaml"
+    config.write_text(yaml.safe_dump(cfg))
+    return config
+
+
+def _lose_first_file(run: Path, before: pd.DataFrame) -> None:
+    assert 1 <= len(before), "nothing was written before the kill"
+    (run / before["solution_file"].iloc[0]).unlink()
+
+
+def test_run_resumes(tmp_path):
+    config = _setup(tmp_path, {"name": "job", "solver": {**SMALL["solver"], "multistart": 5}})
+    out, run = tmp_path / "r", tmp_path / "r" / "job" / "k"
+    before = kill_part_way(["run", str(config), "--out", str(out), "--name", "k", "--no-figures"], run / "summary.csv")
+    assert len(before) < 5, "the run was not killed part-way"
+    _lose_first_file(run, before)
+    again = runner.invoke(app, ["run", str(config), "--out", str(out), "--name", "k"])
+    assert again.exit_code == 2 and "--resume" in again.output  # never overwrites a run silently
+    result = runner.invoke(app, ["run", str(config), "--out", str(out), "--name", "k", "--resume", "--no-figures"])
+    after = check_resumed(run, before, {("", "to", "RRRRRR", s) for s in range(5)}, result)
+    assert after["best"].sum() == 1 and (run / "best.json").is_file()
+
+
+def test_continuous_resumes(tmp_path):
+    config = _setup(tmp_path, {"continuous": {"cases": ["placement_only", "combined"], "methods": ["to", "fk"]}})
+    out, run = tmp_path / "r", tmp_path / "r" / "continuous" / "k"
+    before = kill_part_way(["continuous", str(config), "--out", str(out), "--name", "k"], run / "summary.csv")
+    assert len(before) < 12, "the run was not killed part-way"
+    _lose_first_file(run, before)
+    result = runner.invoke(app, ["continuous", str(config), "--out", str(out), "--name", "k", "--resume"])
+    expected = {(c, m, "RRRRRR", s) for c in ("placement_only", "combined") for m in ("to", "fk") for s in range(3)}
+    check_resumed(run, before, expected, result)
+    assert len(pd.read_csv(run / "table.csv")) == 4
+
+
+def test_waypoints_resumes(tmp_path):
+    config = _setup(tmp_path, {"continuous": {"waypoint_study": [8, 10, 12]}})
+    out, run = tmp_path / "r", tmp_path / "r" / "waypoints" / "k"
+    before = kill_part_way(["waypoints", str(config), "--out", str(out), "--name", "k"], run / "summary.csv")
+    assert len(before) < 9, "the run was not killed part-way"
+    _lose_first_file(run, before)
+    result = runner.invoke(app, ["waypoints", str(config), "--out", str(out), "--name", "k", "--resume"])
+    check_resumed(run, before, {(f"N{n}", "to", "RRRRRR", s) for n in (8, 10, 12) for s in range(3)}, result)
+    table = pd.read_csv(run / "table.csv")
+    assert list(table["waypoints"]) == [8, 10, 12] and table["max_midpoint_error"].notna().all()
+
+
+def test_modular_resumes(tmp_path):
+    config = _setup(tmp_path, {"solver": {**SMALL["solver"], "multistart": 2}})
+    out, run = tmp_path / "r", tmp_path / "r" / "modular" / "k"
+    before = kill_part_way(["modular", str(config), "--out", str(out), "--name", "k"], run / "summary.csv")
+    assert len(before) < 9, "the run was not killed part-way"
+    _lose_first_file(run, before)
+    result = runner.invoke(app, ["modular", str(config), "--out", str(out), "--name", "k", "--resume"])
+    after = read_summary(run / "summary.csv")
+    solves = {(c, m, "RRRRRR", s) for c, m in (("continuous", "to"), ("fk", "fk"), ("continuous_modular", "to"),
+                                                ("modular", "to")) for s in range(2)}
+    rounded = {k for k in after[KEY].itertuples(index=False, name=None) if k[0] == "rounded"}
+    assert len(rounded) == 1
+    check_resumed(run, before, solves | rounded, result)
+    assert len(pd.read_csv(run / "table.csv")) == 5
