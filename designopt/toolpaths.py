@@ -155,7 +155,7 @@ def read_csv(path: Path) -> np.ndarray:
     except csv.Error as exc:
         raise InputError(path, f"line {reader.line_num}", f"malformed CSV: {exc}") from None
     if header is None:
-        raise InputError(path, "(file)", "empty: expected a header x,y,z and at least 3 points")
+        raise InputError(path, "(file)", "empty: expected a header x,y,z and the points below it")
     if not points:
         raise InputError(path, "(file)", "no points below the header")
     points = np.array(points)
