@@ -100,6 +100,8 @@ def run_tests(tree: Path, cache: Path, tests: list[str]) -> tuple[bool, str]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", help="run only mutations whose name contains this text")
+    parser.add_argument("--tests", nargs="+", default=TESTS, help="test files to run (default: the fast ones "
+                                                                  "that guard the objective)")
     args = parser.parse_args()
     chosen = [m for m in MUTATIONS if not args.only or args.only in m.name]
     with tempfile.TemporaryDirectory(prefix="designopt-mutate-") as tmp:
@@ -107,7 +109,7 @@ def main() -> int:
         cache, clean = tmp / "cache", tmp / "clean"
         copy_project(clean)
         start = time.perf_counter()
-        ok, summary = run_tests(clean, cache, TESTS)
+        ok, summary = run_tests(clean, cache, args.tests)
         print(f"baseline (no mutation): {'green' if ok else 'RED'} in {time.perf_counter() - start:.0f} s: {summary}")
         if not ok:
             print("the unmutated suite fails: fix it before judging mutations")
@@ -124,7 +126,7 @@ def main() -> int:
                 continue
             path.write_text(text.replace(m.old, m.new))
             start = time.perf_counter()
-            passed, summary = run_tests(tree, cache, TESTS)
+            passed, summary = run_tests(tree, cache, args.tests)
             survived += passed
             verdict = "SURVIVED" if passed else "caught  "
             print(f"[{i:2d}] {verdict} {m.name} ({time.perf_counter() - start:.0f} s): {summary}", flush=True)
