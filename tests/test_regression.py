@@ -1,0 +1,37 @@
+"""No behaviour change on the default job: start 0 of `designopt run configs/milling.yaml` (seed 0) reproduces the
+solution file stored before the architecture refactor (tests/data/milling_seed0_before_refactor.json, written
+by commit "docs/testing.md: ..." of 2026-11-22) to 1e-6 in design cost, placement and trajectory."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from designopt.config import load_config
+from designopt.experiments.run import multistart_from_config, transcription_from_config
+from designopt.multistart import solve_start
+from designopt.problem import problem_from_config
+from designopt.solution import to_dict
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_default_job_reproduces_the_stored_solution():
+    before = json.loads((ROOT / "tests" / "data" / "milling_seed0_before_refactor.json").read_text())
+    cfg = load_config(ROOT / "configs" / "milling.yaml")
+    problem = problem_from_config(cfg, ROOT / "configs")
+    sol = solve_start(problem, transcription_from_config(cfg), multistart_from_config(cfg), 0)
+    now = to_dict(sol)
+    assert now["metrics"]["status"] == before["metrics"]["status"] == "Solve_Succeeded"
+    assert now["metrics"]["design_cost"] == pytest.approx(before["metrics"]["design_cost"], rel=1e-6)
+    np.testing.assert_allclose(now["placement"]["xyz"], before["placement"]["xyz"], atol=1e-6)
+    np.testing.assert_allclose(now["placement"]["ypr"], before["placement"]["ypr"], atol=1e-6)
+    np.testing.assert_allclose(now["q"], before["q"], atol=1e-6)
+    for row_now, row_before in zip(now["dh"], before["dh"], strict=True):
+        for key in ("theta", "d", "a", "alpha"):
+            assert (row_now[key] is None) == (row_before[key] is None)
+            if row_now[key] is not None:
+                assert row_now[key] == pytest.approx(row_before[key], abs=1e-6)
