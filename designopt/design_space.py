@@ -10,7 +10,19 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from designopt.kinematics.joints import DH_PARAMS, PLACEMENT_PARAMS, Chain, Joint, Role, moving_param
+from designopt.kinematics.joints import (
+    DH_PARAMS,
+    ET,
+    PLACEMENT_PARAMS,
+    REGULARISED,
+    Chain,
+    Joint,
+    Role,
+    X,
+    Y,
+    Z,
+    moving_param,
+)
 
 ANGLE_PARAMS = {"theta", "alpha", "yaw", "pitch", "roll"}
 
@@ -39,6 +51,28 @@ def resolve_design_params(link_type: str, design: Sequence[str]) -> set[str]:
     return chosen - {moving_param(link_type)}
 
 
+def placement_ets(first_joint: int) -> tuple[ET, ...]:
+    """T_BW = Trans(x, y, z) Rz(yaw) Ry(pitch) Rx(roll), for the six placement joints from ``first_joint``."""
+    return tuple(ET(motion, axis, first_joint + k) for k, (motion, axis) in enumerate(
+        [("translate", X), ("translate", Y), ("translate", Z), ("rotate", Z), ("rotate", Y), ("rotate", X)]))
+
+
+def placement_joints(xyz: Sequence[float], ypr: Sequence[float], free: Sequence[str],
+                     bounds: JointBounds = JointBounds()) -> list[Joint]:
+    """The six placement joints; those named in ``free`` are design joints."""
+    joints = []
+    for k, (name, value) in enumerate(zip(PLACEMENT_PARAMS, [*xyz, *ypr], strict=True)):
+        lo, hi = bounds.placement_box[k] if k < 3 else bounds.placement_angle
+        role = Role.DESIGN if name in free else Role.FIXED
+        kind = "angle" if name in ANGLE_PARAMS else "length"
+        joints.append(Joint(f"placement.{name}", kind, role, float(value), lo, hi))
+    return joints
+
+
+# A standard DH link: T = Rz(theta) Tz(d) Tx(a) Rx(alpha).
+DH_ETS = (("rotate", Z), ("translate", Z), ("translate", X), ("rotate", X))
+
+
 def build_chain(
     structure: str,
     dh: Sequence[dict[str, float]],
@@ -48,20 +82,18 @@ def build_chain(
     placement_free: Sequence[str],
     bounds: JointBounds = JointBounds(),
 ) -> Chain:
-    """Assemble the chain: placement joints first, then (theta, d, a, alpha) of every link.
+    """Assemble a DH robot and its placement into one chain: six placement joints, then (theta, d, a, alpha)
+    of every link, each an elementary transform.
 
     ``dh`` gives the initial (or fixed) value of every DH parameter; ``design`` names the DH parameters
     that are design joints; ``placement_free`` names the placement coordinates that are design joints.
     """
-    joints: list[Joint] = []
-    for k, (name, value) in enumerate(zip(PLACEMENT_PARAMS, [*placement_xyz, *placement_ypr], strict=True)):
-        lo, hi = bounds.placement_box[k] if k < 3 else bounds.placement_angle
-        role = Role.DESIGN if name in placement_free else Role.FIXED
-        kind = "angle" if name in ANGLE_PARAMS else "length"
-        joints.append(Joint(f"placement.{name}", kind, role, float(value), lo, hi))
+    joints = placement_joints(placement_xyz, placement_ypr, placement_free, bounds)
+    robot, frames, links = [], [], []
     for i, (link_type, row) in enumerate(zip(structure, dh, strict=True)):
         chosen = resolve_design_params(link_type, design)
-        for param in DH_PARAMS:
+        indices = []
+        for param, (motion, axis) in zip(DH_PARAMS, DH_ETS, strict=True):
             kind = "angle" if param in ANGLE_PARAMS else "length"
             if param == moving_param(link_type):
                 role = Role.MOVING
@@ -69,10 +101,16 @@ def build_chain(
             else:
                 role = Role.DESIGN if param in chosen else Role.FIXED
                 lo, hi = bounds.design_length if kind == "length" else bounds.design_angle
-            joints.append(Joint(f"link{i + 1}.{param}", kind, role, float(row[param]), lo, hi))
-    return Chain(structure=structure, joints=tuple(joints))
+            tags = frozenset({REGULARISED}) if kind == "length" else frozenset()
+            indices.append(len(joints))
+            robot.append(ET(motion, axis, len(joints)))
+            joints.append(Joint(f"link{i + 1}.{param}", kind, role, float(row[param]), lo, hi, tags))
+        links.append(tuple(indices))
+        frames.append(len(robot))
+    return Chain(joints=tuple(joints), placement=placement_ets(0), robot=tuple(robot), frames=tuple(frames),
+                 dh=tuple(links))
 
 
 def design_lengths(chain: Chain) -> list[int]:
-    """Indices into q_d of the design joints that are link lengths (d, a): the regularised ones."""
-    return [i for i, j in enumerate(chain.design) if j.name.startswith("link") and j.kind == "length"]
+    """Indices into q_d of the design joints the regularisation penalises (tagged: link lengths d, a)."""
+    return [i for i, j in enumerate(chain.design) if REGULARISED in j.tags]

@@ -17,7 +17,7 @@ from designopt.costs import Stiffness
 from designopt.design_space import JointBounds, build_chain, design_lengths
 from designopt.errors import InputError
 from designopt.kinematics.chain import placement_pose
-from designopt.kinematics.joints import Chain
+from designopt.kinematics.joints import DH_PARAMS, Chain, Role
 
 
 @dataclass(frozen=True)
@@ -88,21 +88,22 @@ def toolpath_from_config(cfg: Config, base_dir: Path) -> toolpaths.Toolpath:
         raise cfg.error("toolpath", str(exc)) from None
 
 
-def _config_key(joint_name: str) -> str:
-    """The config key a user edits to change a joint's start value ('link3.d' -> 'robot.dh[2].d')."""
-    group, param = joint_name.split(".")
-    if group == "placement":
-        return "placement.xyz" if param in "xyz" else "placement.ypr"
-    return f"robot.dh[{int(group.removeprefix('link')) - 1}].{param}"
+def _config_keys(chain: Chain) -> dict[int, str]:
+    """The config key a user edits to change each joint's start value (index into chain.joints -> key)."""
+    keys = {et.joint: "placement.xyz" if k < 3 else "placement.ypr" for k, et in enumerate(chain.placement)}
+    for i, link in enumerate(chain.dh or ()):
+        keys.update({j: f"robot.dh[{i}].{param}" for j, param in zip(link, DH_PARAMS, strict=True)})
+    return keys
 
 
 def check_start_values(cfg: Config, chain: Chain) -> None:
     """Every design joint starts inside its bounds: start 0 of a multistart is the configured design, and
     silently clipping it would make it another one."""
-    for j in chain.design:
-        if not j.lower <= j.value <= j.upper:
-            raise cfg.error(_config_key(j.name), f"start value {j.value:g} of design joint {j.name} lies outside "
-                                                 f"its bounds [{j.lower:g}, {j.upper:g}]")
+    keys = _config_keys(chain)
+    for i, j in enumerate(chain.joints):
+        if j.role is Role.DESIGN and not j.lower <= j.value <= j.upper:
+            raise cfg.error(keys.get(i, "robot"), f"start value {j.value:g} of design joint {j.name} lies outside "
+                                                  f"its bounds [{j.lower:g}, {j.upper:g}]")
 
 
 def check_standoff(cfg: Config, chain: Chain, toolpath: toolpaths.Toolpath) -> None:

@@ -156,8 +156,9 @@ def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, on_solut
     if continuous is None:
         return None, [], None
     assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)
+    placed = {j.name for j in base.chain.placement_joints}
     placement = {j.name: float(v) for j, v in zip(base.chain.design, continuous.raw.q_d, strict=True)
-                 if j.name.startswith("placement.")}
+                 if j.name in placed}
     modular = _stage(run, fix_modules(base, assignment, catalogue, placement), to, settings, f"{tag}modular",
                      on_solution, resume)
     return continuous, assignment, modular
@@ -193,7 +194,7 @@ def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str
     small_to = transcription_from_config(small_cfg)
     _, rounded_assignment, rounded_best = _round_and_resolve(run, small_base, small_to, settings, small,
                                                              cfg.modular.weight, "enum-", on_solution, resume)
-    placement = {j.name: j.value for j in small_base.chain.design if j.name.startswith("placement.")}
+    placement = {j.name: j.value for j in small_base.chain.placement_joints if j.role is Role.DESIGN}
     rows = []
     for assignment in itertools.product(range(len(subset)), repeat=small_base.chain.n_links):
         best = _stage(run, fix_modules(small_base, list(assignment), small, placement), small_to, settings,

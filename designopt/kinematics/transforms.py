@@ -47,6 +47,19 @@ def trans(x, y, z):
     return matrix([[1, 0, 0, x], [0, 1, 0, y], [0, 0, 1, z], [0, 0, 0, 1]], is_symbolic(x, y, z))
 
 
+def axis_rotation(axis, angle):
+    """Rotation by ``angle`` about the unit ``axis`` (Rodrigues), as a 4x4 transform."""
+    c, s = _cos_sin(angle)
+    x, y, z = (float(v) for v in axis)
+    v = 1 - c
+    return matrix([
+        [c + x * x * v, x * y * v - z * s, x * z * v + y * s, 0],
+        [y * x * v + z * s, c + y * y * v, y * z * v - x * s, 0],
+        [z * x * v - y * s, z * y * v + x * s, c + z * z * v, 0],
+        [0, 0, 0, 1],
+    ], is_symbolic(angle))
+
+
 def dh_transform(theta, d, a, alpha):
     """Standard DH link transform T = Rz(theta) Tz(d) Tx(a) Rx(alpha), in closed form."""
     symbolic = is_symbolic(theta, d, a, alpha)
