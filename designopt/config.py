@@ -83,12 +83,22 @@ class DHRow(_Strict):
 
 
 class RobotConfig(_Strict):
+    """A DH robot (structure, dh, design) or a URDF robot (urdf, base_link, tool_link, design_origins)."""
+
     structure: Annotated[str, Field(pattern=r"^[RP]{1,12}$")] = "RRRRRR"
     design: list[Literal["theta", "d", "a", "alpha"]] = ["d", "a", "alpha"]
     dh: str | list[DHRow] = "puma560"
+    urdf: str | None = None  # path relative to the config
+    base_link: str | None = None
+    tool_link: str | None = None
+    design_origins: list[str] = []  # URDF origin components that are design joints, e.g. elbow_joint.origin.z
     bounds: BoundsConfig = BoundsConfig()
     stiffness: Positive | StiffnessConfig = 1.0
     joint_velocity: Positive = 10.0
+
+    @property
+    def is_urdf(self) -> bool:
+        return self.urdf is not None
 
     @field_validator("dh")
     @classmethod
@@ -227,7 +237,20 @@ def _semantic_errors(cfg: Config, base_dir: Path) -> list[tuple[str, str]]:
     """Checks that span several keys; each names the key a user must change."""
     errors = []
     n = len(cfg.robot.structure)
-    if isinstance(cfg.robot.dh, str):
+    if cfg.robot.is_urdf:
+        for key in ("structure", "dh", "design"):
+            if key in cfg.robot.model_fields_set:
+                errors.append((f"robot.{key}", "a URDF robot takes its joints from robot.urdf (design joints: "
+                                               "robot.design_origins)"))
+        for key in ("base_link", "tool_link"):
+            if getattr(cfg.robot, key) is None:
+                errors.append((f"robot.{key}", "needed with robot.urdf: the chain runs from base_link to tool_link"))
+        if not (base_dir / cfg.robot.urdf).is_file():
+            errors.append(("robot.urdf", f"no such file: {(base_dir / cfg.robot.urdf).resolve()}"))
+    elif cfg.robot.design_origins or cfg.robot.base_link or cfg.robot.tool_link:
+        errors.append(("robot.design_origins" if cfg.robot.design_origins else "robot.base_link",
+                       "only for a URDF robot (robot.urdf)"))
+    elif isinstance(cfg.robot.dh, str):
         if cfg.robot.dh in PRESETS and len(PRESETS[cfg.robot.dh]) != n:
             errors.append(("robot.dh", f"preset '{cfg.robot.dh}' has {len(PRESETS[cfg.robot.dh])} links, "
                                        f"structure {cfg.robot.structure} has {n}"))
@@ -307,8 +330,10 @@ def load_config(path: str | Path) -> Config:
 
 
 def dump_config(cfg: Config) -> str:
-    """The resolved config as YAML (every default filled in)."""
-    return yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False)
+    """The resolved config as YAML (every default filled in; a robot's keys of the other kind left out)."""
+    unused = {"structure", "dh", "design"} if cfg.robot.is_urdf else {"urdf", "base_link", "tool_link",
+                                                                      "design_origins"}
+    return yaml.safe_dump(cfg.model_dump(mode="json", exclude={"robot": unused}), sort_keys=False)
 
 
 def dh_rows(cfg: Config) -> list[dict[str, float]]:

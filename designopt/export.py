@@ -38,8 +38,10 @@ def urdf_model(data: dict, name: str = "designopt_cell", sphere_radius: float = 
     links = [y.Link(name=BASE, visuals=[y.Visual(geometry=y.Geometry(sphere=y.Sphere(0.03)), material=grey)])]
     joints = []
     parent = BASE
-    limits = data.get("joint_limits") or [{} for _ in data["dh"]]
-    for i, (row, lim) in enumerate(zip(data["dh"], limits, strict=True), start=1):
+    limits = data.get("joint_limits") or [{} for _ in data["structure"]]
+    if "dh" not in data:
+        parent = _ets_robot(data, limits, links, joints, grey)
+    for i, (row, lim) in enumerate(zip(data.get("dh", []), limits[: len(data.get("dh", []))], strict=True), start=1):
         moving, frame = f"link{i}_moving", f"frame{i}"
         lower = lim.get("lower", -2 * np.pi if row["type"] == "R" else -2.0)
         upper = lim.get("upper", 2 * np.pi if row["type"] == "R" else 2.0)
@@ -83,6 +85,36 @@ def urdf_model(data: dict, name: str = "designopt_cell", sphere_radius: float = 
     return y.URDF(robot=robot, build_scene_graph=True, load_meshes=False)
 
 
+def _ets_robot(data: dict, limits: list, links: list, joints: list, material) -> str:
+    """URDF joints of an elementary-transform chain: the fixed ETs between two moving ones become the next
+    joint's origin. Returns the name of the last link."""
+    import yourdfpy as y
+
+    from designopt.verify import _rotation, _translation
+
+    parent, fixed, i = BASE, np.eye(4), 0
+    for et in data["ets"]:
+        if et["value"] is not None:
+            step = _rotation if et["motion"] == "rotate" else _translation
+            fixed = fixed @ step(et["axis"], et["value"])
+            continue
+        i += 1
+        lim, child = limits[i - 1], f"link{i}"
+        revolute = et["motion"] == "rotate"
+        joints.append(y.Joint(
+            name=f"joint{i}", type="revolute" if revolute else "prismatic", parent=parent, child=child,
+            origin=fixed, axis=np.array(et["axis"], dtype=float),
+            limit=y.Limit(effort=0.0, velocity=float(lim.get("velocity_per_task_time", 10.0)),
+                          lower=float(lim.get("lower", -2 * np.pi if revolute else -2.0)),
+                          upper=float(lim.get("upper", 2 * np.pi if revolute else 2.0)))))
+        links.append(y.Link(name=child, visuals=[y.Visual(geometry=y.Geometry(sphere=y.Sphere(0.02)),
+                                                          material=material)]))
+        parent, fixed = child, np.eye(4)
+    links.append(y.Link(name="flange"))
+    joints.append(y.Joint(name="flange_mount", type="fixed", parent=parent, child="flange", origin=fixed))
+    return "flange"
+
+
 def _axis_angle(axis, angle) -> np.ndarray:
     n = np.linalg.norm(axis)
     if n < 1e-12:
@@ -98,7 +130,7 @@ def export(data: dict, out_dir: Path, stem: str = "cell") -> list[Path]:
     urdf_path = out_dir / f"{stem}.urdf"
     urdf_model(data).write_xml_file(str(urdf_path))
     t, Q = data["toolpath"]["t"], data["q"]
-    names = [f"joint{i + 1}" for i in range(len(data["dh"]))]
+    names = [f"joint{i + 1}" for i in range(len(data["structure"]))]
     csv_path = out_dir / f"{stem}_trajectory.csv"
     with csv_path.open("w", newline="") as fh:
         writer = csv.writer(fh)
@@ -108,7 +140,7 @@ def export(data: dict, out_dir: Path, stem: str = "cell") -> list[Path]:
     yaml_path = out_dir / f"{stem}_trajectory.yaml"
     yaml_path.write_text(yaml.safe_dump({
         "joint_names": names, "time_unit": "normalised task time in [0, 1]",
-        "units": ["rad" if r["type"] == "R" else "m" for r in data["dh"]],
+        "units": ["rad" if kind == "R" else "m" for kind in data["structure"]],
         "points": [{"t": float(tk), "positions": [float(v) for v in q]} for tk, q in zip(t, Q, strict=True)],
     }, sort_keys=False))
     return [urdf_path, csv_path, yaml_path]

@@ -14,7 +14,7 @@ import numpy as np
 from designopt import toolpaths
 from designopt.config import Config, dh_rows
 from designopt.costs import Stiffness
-from designopt.design_space import JointBounds, build_chain, design_lengths
+from designopt.design_space import JointBounds, build_chain, design_lengths, placement_ets, placement_joints
 from designopt.errors import InputError
 from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.joints import DH_PARAMS, Chain, Role
@@ -140,6 +140,18 @@ def stiffness_from_config(cfg: Config) -> Stiffness:
     return Stiffness(k.revolute, k.prismatic)
 
 
+def robot_chain(cfg: Config, base_dir: Path, bounds: JointBounds) -> Chain:
+    """The config's robot and placement as one chain: a DH table or a URDF serial chain."""
+    r, p = cfg.robot, cfg.placement
+    if not r.is_urdf:
+        return build_chain(r.structure, dh_rows(cfg), r.design, p.xyz, p.ypr, p.free, bounds)
+    from designopt.kinematics.urdf import chain_from_urdf
+
+    return chain_from_urdf(base_dir / r.urdf, r.base_link, r.tool_link, r.design_origins,
+                           placement_joints(p.xyz, p.ypr, p.free, bounds), placement_ets(0), bounds.design_length,
+                           bounds.design_angle, bounds.revolute, bounds.prismatic, cfg.error)
+
+
 def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProblem:
     """Turn a validated config into a DesignProblem."""
     b = cfg.robot.bounds
@@ -150,15 +162,7 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         prismatic=b.prismatic,
         placement_box=cfg.placement.box,
     )
-    chain = build_chain(
-        cfg.robot.structure,
-        dh_rows(cfg),
-        cfg.robot.design,
-        cfg.placement.xyz,
-        cfg.placement.ypr,
-        cfg.placement.free,
-        bounds,
-    )
+    chain = robot_chain(cfg, base_dir, bounds)
     check_start_values(cfg, chain)
     toolpath = toolpath_from_config(cfg, base_dir)
     check_standoff(cfg, chain, toolpath)

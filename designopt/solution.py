@@ -75,24 +75,33 @@ def _finite(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
+def robot_description(chain: Chain) -> dict:
+    """The solved robot as the file carries it: a DH table (``dh``, the moving parameter null) when the robot
+    is one, else its elementary-transform chain (``ets``: motion, unit axis, value; null for a moving joint)."""
+    values = chain.values(np.zeros(chain.n_moving), np.zeros(0))
+    if chain.dh is not None:
+        dh = []
+        for link_type, link in zip(chain.structure, chain.dh, strict=True):
+            row = {"type": link_type}
+            for name, index in zip(DH_PARAMS, link, strict=True):
+                row[name] = None if chain.joints[index].role is Role.MOVING else float(values[index])
+            dh.append(row)
+        return {"dh": dh}
+    return {"ets": [{"motion": et.motion, "axis": list(et.axis),
+                     "value": None if chain.joints[et.joint].role is Role.MOVING else float(values[et.joint])}
+                    for et in chain.robot]}
+
+
 def to_dict(sol: Solution) -> dict:
     """The solution as a JSON-ready dict in schema designopt.solution/1."""
     chain, p = sol.chain, sol.problem
-    links = chain.link_values(np.zeros(chain.n_moving), np.zeros(0))
-    dh = []
-    for link_type, params in zip(chain.structure, links, strict=True):
-        row = {"type": link_type}
-        for name, value in zip(DH_PARAMS, params, strict=True):
-            moving = (name == "theta" and link_type == "R") or (name == "d" and link_type == "P")
-            row[name] = None if moving else float(value)
-        dh.append(row)
     placement = chain.placement_values(np.zeros(chain.n_moving), np.zeros(0))
     m, r = sol.metrics, sol.raw
     return {
         "schema": SCHEMA,
         "method": sol.method,
         "structure": chain.structure,
-        "dh": dh,
+        **robot_description(chain),
         "tool": [list(map(float, row)) for row in chain.tool],
         "placement": {"xyz": [float(v) for v in placement[:3]], "ypr": [float(v) for v in placement[3:]]},
         "stiffness": [float(k) for k in p.stiffness.diagonal(chain.structure)],
@@ -188,8 +197,21 @@ def read_solution_for(problem: DesignProblem, method: str, path: Path, label: st
 
 def chain_from_file(data: dict) -> Chain:
     """Rebuild the solved chain (every design joint fixed) from a designopt.solution/1 dict."""
-    from designopt.design_space import build_chain
+    from designopt.design_space import build_chain, placement_ets, placement_joints
+    from designopt.kinematics.joints import ET, Joint
 
-    rows = [{k: (0.0 if row[k] is None else row[k]) for k in DH_PARAMS} for row in data["dh"]]
-    chain = build_chain(data["structure"], rows, [], data["placement"]["xyz"], data["placement"]["ypr"], ())
+    xyz, ypr = data["placement"]["xyz"], data["placement"]["ypr"]
+    if "dh" in data:
+        rows = [{k: (0.0 if row[k] is None else row[k]) for k in DH_PARAMS} for row in data["dh"]]
+        chain = build_chain(data["structure"], rows, [], xyz, ypr, ())
+    else:
+        joints, robot, frames = placement_joints(xyz, ypr, ()), [], []
+        for k, et in enumerate(data["ets"]):
+            moving = et["value"] is None
+            kind = "angle" if et["motion"] == "rotate" else "length"
+            robot.append(ET(et["motion"], tuple(float(v) for v in et["axis"]), len(joints)))
+            joints.append(Joint(f"et{k}", kind, Role.MOVING if moving else Role.FIXED, 0.0 if moving else et["value"]))
+            if moving:
+                frames.append(len(robot))
+        chain = Chain(tuple(joints), placement_ets(0), tuple(robot), tuple(frames))
     return replace(chain, tool=tuple(tuple(float(v) for v in r) for r in data["tool"]))

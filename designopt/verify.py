@@ -45,6 +45,31 @@ def _array(data: dict, key: str, shape: tuple, file) -> np.ndarray:
     return arr
 
 
+def _check_ets(ets: object, structure: str, file) -> None:
+    """An elementary-transform chain: motion, unit axis, finite value (null for the moving joints, whose
+    types spell the structure)."""
+    if not isinstance(ets, list) or not ets:
+        raise SolutionFileError(file, "ets", "expected a list of elementary transforms")
+    kinds = ""
+    for i, et in enumerate(ets):
+        if not isinstance(et, dict) or et.get("motion") not in ("translate", "rotate"):
+            raise SolutionFileError(file, f"ets[{i}].motion", "expected translate or rotate")
+        axis = et.get("axis")
+        try:
+            axis = np.array(axis, dtype=float)
+        except (TypeError, ValueError):
+            raise SolutionFileError(file, f"ets[{i}].axis", "expected 3 numbers") from None
+        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or abs(np.linalg.norm(axis) - 1) > 1e-9:
+            raise SolutionFileError(file, f"ets[{i}].axis", "expected a unit vector of 3 numbers")
+        value = et.get("value", "missing")
+        if value is None:
+            kinds += "R" if et["motion"] == "rotate" else "P"
+        elif isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            raise SolutionFileError(file, f"ets[{i}].value", f"expected a finite number or null, got {value!r}")
+    if kinds != structure:
+        raise SolutionFileError(file, "ets", f"its moving joints are {kinds or 'none'}, the structure is {structure}")
+
+
 def check_schema(data: object, file="<solution>") -> None:
     """Raise SolutionFileError unless ``data`` has every field of designopt.solution/1 with the right shape."""
     if not isinstance(data, dict):
@@ -55,9 +80,17 @@ def check_schema(data: object, file="<solution>") -> None:
     if not isinstance(structure, str) or not structure or set(structure) - {"R", "P"}:
         raise SolutionFileError(file, "structure", f"expected a string over R and P, got {structure!r}")
     n = len(structure)
-    dh = data.get("dh")
-    if not isinstance(dh, list) or len(dh) != n:
-        raise SolutionFileError(file, "dh", f"expected {n} rows for structure {structure}")
+    if "ets" in data and "dh" not in data:
+        _check_ets(data["ets"], structure, file)
+    else:
+        _check_dh(data.get("dh"), structure, file)
+    _check_rest(data, n, file)
+
+
+def _check_dh(dh: object, structure: str, file) -> None:
+    """A DH table: one row per link, the moving parameter null, the others finite."""
+    if not isinstance(dh, list) or len(dh) != len(structure):
+        raise SolutionFileError(file, "dh", f"expected {len(structure)} rows for structure {structure}")
     for i, (row, link_type) in enumerate(zip(dh, structure, strict=True)):
         if not isinstance(row, dict) or row.get("type") != link_type:
             raise SolutionFileError(file, f"dh[{i}].type", f"expected {link_type!r} (structure {structure})")
@@ -69,6 +102,10 @@ def check_schema(data: object, file="<solution>") -> None:
                     raise SolutionFileError(file, f"dh[{i}].{param}", "the moving parameter must be null")
             elif isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
                 raise SolutionFileError(file, f"dh[{i}].{param}", f"expected a finite number, got {value!r}")
+
+
+def _check_rest(data: dict, n: int, file) -> None:
+    """Tool, placement, stiffness, force, toolpath, joint values and metrics of an n-joint robot."""
     _array(data, "tool", (4, 4), file)
     _array(data, "placement.xyz", (3,), file)
     _array(data, "placement.ypr", (3,), file)
@@ -126,6 +163,47 @@ def _rot(axis, angle):
     return R
 
 
+def _translation(axis, value):
+    T = np.eye(4)
+    T[:3, 3] = np.asarray(axis, dtype=float) * value
+    return T
+
+
+def _rotation(axis, angle):
+    """Rodrigues: rotation by angle about the unit axis."""
+    k = np.asarray(axis, dtype=float)
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    T = np.eye(4)
+    T[:3, :3] = np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+    return T
+
+
+def _robot_walk(data: dict, q) -> tuple:
+    """Last link frame in B, and the origin, axis (in B) and type of every moving joint, from the file's DH
+    table or its elementary-transform chain."""
+    T, origins, axes, kinds = np.eye(4), [], [], []
+    q = iter(q)
+    if "dh" in data:
+        for row in data["dh"]:
+            origins.append(T[:3, 3].copy())
+            axes.append(T[:3, 2].copy())
+            kinds.append(row["type"])
+            value = next(q)
+            theta = value if row["type"] == "R" else row["theta"]
+            d = value if row["type"] == "P" else row["d"]
+            T = T @ _dh(theta, d, row["a"], row["alpha"])
+        return T, origins, axes, kinds
+    for et in data["ets"]:
+        value = et["value"]
+        if value is None:
+            value = next(q)
+            origins.append(T[:3, 3].copy())
+            axes.append(T[:3, :3] @ np.asarray(et["axis"], dtype=float))
+            kinds.append("R" if et["motion"] == "rotate" else "P")
+        T = T @ (_rotation(et["axis"], value) if et["motion"] == "rotate" else _translation(et["axis"], value))
+    return T, origins, axes, kinds
+
+
 @dataclass(frozen=True)
 class Check:
     design_cost: float
@@ -150,19 +228,11 @@ def recompute(data: dict, position_tol: float = 1e-3, axis_tol: float = 1e-2, de
     dt = 1.0 / (len(pts) - 1)
     cost, pos_err, axis_err = 0.0, 0.0, 0.0
     for k in range(len(pts)):
-        T = np.eye(4)
-        origins, axes = [], []
-        for row, q in zip(data["dh"], Q[k], strict=True):
-            origins.append(T[:3, 3].copy())
-            axes.append(T[:3, 2].copy())
-            theta = q if row["type"] == "R" else row["theta"]
-            d = q if row["type"] == "P" else row["d"]
-            T = T @ _dh(theta, d, row["a"], row["alpha"])
+        T, origins, axes, kinds = _robot_walk(data, Q[k])
         T = T @ tool
         p = T[:3, 3]
-        cols = []
-        for row, o, zi in zip(data["dh"], origins, axes, strict=True):
-            cols.append(np.r_[np.cross(zi, p - o), zi] if row["type"] == "R" else np.r_[zi, 0, 0, 0])
+        cols = [np.r_[np.cross(a, p - o), a] if kind == "R" else np.r_[a, 0, 0, 0]
+                for kind, o, a in zip(kinds, origins, axes, strict=True)]
         J = np.array(cols).T
         w = np.r_[T_BW[:3, :3] @ forces[k], 0, 0, 0]
         delta = J @ np.diag(k_inv) @ J.T @ w

@@ -31,6 +31,9 @@ CASE_LABELS = {"placement_only": "placement only", "design_only": "design only",
 def case_config(cfg: Config, case: str) -> Config:
     """The config of one case: the same robot and cell with other joints marked as design joints."""
     robot, placement = cfg.robot, cfg.placement
+    if robot.is_urdf:
+        raise cfg.error("robot.urdf", "this experiment varies DH parameters and needs a DH robot (robot.structure, "
+                                      "robot.dh); `designopt run` takes URDF robots")
     design = robot.design or ["d", "a", "alpha"]
     if case == "placement_only":
         robot, placement = robot.model_copy(update={"design": []}), placement.model_copy(update={"optimize": True})
@@ -83,14 +86,14 @@ def best_table(solutions: dict) -> pd.DataFrame:
 def run_continuous(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
                    on_solution: Callable[[str, Solution], None] | None = None, figures: bool = True,
                    experiment: str = "continuous", resume: bool = False) -> ContinuousResult:
-    run = RunDirectory.create(out_root, experiment, run_name, resume)
-    run.write_config(dump_config(cfg))
     settings = multistart_from_config(cfg)
     tasks = []
     for case in cfg.continuous.cases:
         problem = problem_from_config(case_config(cfg, case), base_dir)
         for method in cfg.continuous.methods:
             tasks += multistart_tasks(case, method, problem, method_transcription(cfg, method), settings)
+    run = RunDirectory.create(out_root, experiment, run_name, resume)  # only once the input is known good
+    run.write_config(dump_config(cfg))
     run.log(f"start continuous: {len(tasks)} solves ({len(cfg.continuous.cases)} cases x "
             f"{len(cfg.continuous.methods)} methods x {settings.count} starts)")
     done = solve_tasks(run, tasks, experiment, settings.jobs, resume,

@@ -32,6 +32,8 @@ def enumerate_structures(min_dof: int = 1, max_dof: int = 6) -> list[str]:
 
 def structure_config(cfg: Config, structure: str) -> Config:
     """The sweep's config for one structure: generic start design, every link's d/theta, a, alpha free."""
+    if cfg.robot.is_urdf:
+        raise cfg.error("robot.urdf", "the structure sweep builds DH robots; a URDF robot has one structure")
     robot = cfg.robot.model_copy(update={"structure": structure, "dh": "generic", "design": ["d", "a", "alpha"]})
     return cfg.model_copy(update={"robot": robot})
 

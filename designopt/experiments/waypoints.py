@@ -44,9 +44,10 @@ def midpoint_errors(sol: Solution, cfg: Config, base_dir: Path) -> np.ndarray:
 def run_waypoint_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
                        on_solution: Callable[[int, Solution], None] | None = None,
                        figures: bool = True, resume: bool = False) -> pd.DataFrame:
+    base = case_config(cfg, "combined")
+    problem_from_config(base, base_dir)  # bad input stops here, before a run directory exists
     run = RunDirectory.create(out_root, "waypoints", run_name, resume)
     run.write_config(dump_config(cfg))
-    base = case_config(cfg, "combined")
     rows = []
     for n in cfg.continuous.waypoint_study:
         c = base.model_copy(update={"toolpath": base.toolpath.model_copy(update={"waypoints": n})})

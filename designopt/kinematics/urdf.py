@@ -1,0 +1,108 @@
+"""Robots from URDF: a serial chain between two links, built into the same elementary-transform chain as a
+DH robot.
+
+Every URDF joint on the way from ``base_link`` to ``tool_link`` contributes its origin -- six ETs
+x, y, z, yaw, pitch, roll (URDF's rpy is Rz(yaw) Ry(pitch) Rx(roll)), each a joint named
+``<joint>.origin.<component>`` that is fixed unless named a design joint -- followed, for a revolute,
+continuous or prismatic joint, by its motion about or along its axis (a moving joint named after the URDF
+joint, with the URDF's limits). The tool frame is ``tool_link``'s frame.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from designopt.errors import InputError
+from designopt.kinematics.joints import ET, REGULARISED, Chain, Joint, Role, X, Y, Z
+
+ORIGIN = (("x", "translate", X), ("y", "translate", Y), ("z", "translate", Z),
+          ("yaw", "rotate", Z), ("pitch", "rotate", Y), ("roll", "rotate", X))
+MOVING_TYPES = {"revolute": "rotate", "continuous": "rotate", "prismatic": "translate"}
+
+
+def rpy_of(R: np.ndarray) -> tuple[float, float, float]:
+    """(roll, pitch, yaw) with R = Rz(yaw) Ry(pitch) Rx(roll) (URDF's convention)."""
+    pitch = math.asin(max(-1.0, min(1.0, -R[2, 0])))
+    if abs(R[2, 0]) < 1 - 1e-12:
+        return math.atan2(R[2, 1], R[2, 2]), pitch, math.atan2(R[1, 0], R[0, 0])
+    return 0.0, pitch, math.atan2(-R[0, 1], R[1, 1])  # gimbal lock: put it all in yaw
+
+
+def serial_joints(urdf, base_link: str, tool_link: str, config_error) -> list:
+    """The URDF joints from base_link down to tool_link, in order."""
+    links = {link.name for link in urdf.robot.links}
+    for key, name in (("robot.base_link", base_link), ("robot.tool_link", tool_link)):
+        if name not in links:
+            raise config_error(key, f"no link {name!r} in the URDF (links: {', '.join(sorted(links))})")
+    by_child = {j.child: j for j in urdf.robot.joints}
+    path, link = [], tool_link
+    while link != base_link:
+        if link not in by_child:
+            raise config_error("robot.tool_link", f"{tool_link!r} is not below {base_link!r} in the URDF tree")
+        path.append(by_child[link])
+        link = by_child[link].parent
+    return path[::-1]
+
+
+def load_urdf(path: Path):
+    import yourdfpy
+
+    try:
+        return yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False)
+    except Exception as exc:  # yourdfpy raises what lxml or its own parser raise: all mean "not a URDF"
+        reason = str(exc).splitlines()[0] if str(exc) else repr(exc)
+        raise InputError(path, "(file)", f"not a readable URDF: {reason}") from None
+
+
+def chain_from_urdf(path: Path, base_link: str, tool_link: str, design: Sequence[str], placement: list[Joint],
+                    placement_ets: tuple[ET, ...], length_bounds: tuple[float, float],
+                    angle_bounds: tuple[float, float], revolute: tuple[float, float],
+                    prismatic: tuple[float, float], config_error=None) -> Chain:
+    """The chain of a URDF robot after the given placement joints.
+
+    ``design`` names origin components that become design joints (``elbow_joint.origin.z``); joint limits
+    come from the URDF (continuous joints, and joints without limits, take ``revolute``/``prismatic``).
+    ``config_error(key, reason)`` makes the exception for a mistake in the config (not in the URDF).
+    """
+    if config_error is None:
+        def config_error(key, reason):
+            return InputError("<config>", key, reason)
+    urdf = load_urdf(path)
+    joints, robot, frames = list(placement), [], []
+    known = set()
+    for uj in serial_joints(urdf, base_link, tool_link, config_error):
+        origin = np.asarray(uj.origin if uj.origin is not None else np.eye(4), dtype=float)
+        roll, pitch, yaw = rpy_of(origin[:3, :3])
+        values = dict(zip(("x", "y", "z"), origin[:3, 3], strict=True)) | {"yaw": yaw, "pitch": pitch, "roll": roll}
+        for component, motion, axis in ORIGIN:
+            name = f"{uj.name}.origin.{component}"
+            known.add(name)
+            length = motion == "translate"
+            lo, hi = length_bounds if length else angle_bounds
+            role = Role.DESIGN if name in design else Role.FIXED
+            tags = frozenset({REGULARISED}) if length else frozenset()
+            robot.append(ET(motion, axis, len(joints)))
+            joints.append(Joint(name, "length" if length else "angle", role, float(values[component]), lo, hi, tags))
+        if uj.type in MOVING_TYPES:
+            motion = MOVING_TYPES[uj.type]
+            axis = np.asarray(uj.axis if uj.axis is not None else (1.0, 0.0, 0.0), dtype=float)
+            axis = tuple(float(v) for v in axis / np.linalg.norm(axis))
+            lo, hi = revolute if motion == "rotate" else prismatic
+            if uj.type != "continuous" and uj.limit is not None and uj.limit.lower is not None \
+                    and uj.limit.upper is not None and uj.limit.lower < uj.limit.upper:
+                lo, hi = float(uj.limit.lower), float(uj.limit.upper)
+            robot.append(ET(motion, axis, len(joints)))
+            joints.append(Joint(uj.name, "angle" if motion == "rotate" else "length", Role.MOVING, 0.0, lo, hi))
+        elif uj.type != "fixed":
+            raise InputError(path, "robot.urdf", f"joint {uj.name!r} is {uj.type}: only revolute, continuous, "
+                                                 "prismatic and fixed joints make a serial chain")
+        frames.append(len(robot))
+    unknown = sorted(set(design) - known)
+    if unknown:
+        raise config_error("robot.design_origins", f"no origin component {unknown[0]!r} on the way from "
+                                                   f"{base_link!r} to {tool_link!r}")
+    return Chain(joints=tuple(joints), placement=placement_ets, robot=tuple(robot), frames=tuple(frames))

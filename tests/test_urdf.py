@@ -1,0 +1,135 @@
+"""Robots from URDF: the chain built from the file against pinocchio on the same file, design joints by name,
+and the UR10 example end to end."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from cli.main import app
+from designopt.config import parse_config
+from designopt.kinematics.chain import geometric_jacobian, tool_pose
+from designopt.problem import problem_from_config
+from designopt.verify import verify_file
+
+pin = pytest.importorskip("pinocchio")
+ROOT = Path(__file__).resolve().parent.parent
+UR10 = ROOT / "configs" / "robots" / "ur10.urdf"
+OFFAXIS = ROOT / "tests" / "data" / "offaxis.urdf"
+
+
+def urdf_problem(path: Path, base: str, tool: str, **robot):
+    cfg = parse_config({"robot": {"urdf": path.name, "base_link": base, "tool_link": tool, **robot},
+                        "placement": {"xyz": [0.5, 0.0, 0.0]}}, "cfg.yaml", path.parent)
+    return problem_from_config(cfg, path.parent)
+
+
+@pytest.mark.parametrize("path,base,tool,structure", [(UR10, "base_link", "tool0", "RRRRRR"),
+                                                      (OFFAXIS, "root", "tip", "RPRR")], ids=["ur10", "offaxis"])
+def test_urdf_chain_matches_pinocchio(path, base, tool, structure, rng):
+    problem = urdf_problem(path, base, tool)
+    chain = problem.chain
+    assert chain.structure == structure
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    frame = model.getFrameId(tool)
+    # pinocchio orders joints as the tree does; here the tree is the chain
+    assert [model.names[i] for i in range(1, model.njoints)] == [j.name for j in chain.moving]
+    lo, hi = np.array([j.lower for j in chain.moving]), np.array([j.upper for j in chain.moving])
+    np.testing.assert_allclose(lo, model.lowerPositionLimit)
+    np.testing.assert_allclose(hi, model.upperPositionLimit)
+    for _ in range(20):
+        q = rng.uniform(lo, hi)
+        pin.framesForwardKinematics(model, data, q)
+        T_base = data.oMf[model.getFrameId(base)].homogeneous
+        T_tool = np.linalg.inv(T_base) @ data.oMf[frame].homogeneous
+        np.testing.assert_allclose(tool_pose(chain, q, chain.design_values), T_tool, atol=1e-9)
+        J = pin.computeFrameJacobian(model, data, q, frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        np.testing.assert_allclose(geometric_jacobian(chain, q, chain.design_values), J, atol=1e-9)
+
+
+def test_any_origin_component_is_a_design_joint_by_name():
+    problem = urdf_problem(UR10, "base_link", "tool0", design_origins=["elbow_joint.origin.z",
+                                                                       "wrist_1_joint.origin.z"])
+    design = {j.name: j for j in problem.chain.design}
+    assert {"elbow_joint.origin.z", "wrist_1_joint.origin.z"} <= set(design)
+    assert design["elbow_joint.origin.z"].value == pytest.approx(0.612)  # the UR10's upper-arm length
+    assert problem.regularized  # design lengths are regularised like DH lengths
+    # changing that design joint moves the tool by the change along the upper arm
+    chain = problem.chain
+    q = np.zeros(6)
+    moved = chain.with_roles({}, {"elbow_joint.origin.z": 0.712})
+    delta = tool_pose(moved, q, moved.design_values)[:3, 3] - tool_pose(chain, q, chain.design_values)[:3, 3]
+    assert np.linalg.norm(delta) == pytest.approx(0.1, abs=1e-12)
+
+
+@pytest.mark.parametrize("robot,key,reason", [
+    ({"urdf": "ur10.urdf", "base_link": "base_link", "tool_link": "nowhere"}, "robot.tool_link", "no link"),
+    ({"urdf": "ur10.urdf", "base_link": "tool0", "tool_link": "base_link"}, "robot.tool_link", "not below"),
+    ({"urdf": "ur10.urdf", "base_link": "base_link", "tool_link": "tool0", "design_origins": ["elbow.origin.q"]},
+     "robot.design_origins", "no origin component"),
+    ({"urdf": "ur10.urdf", "base_link": "base_link", "tool_link": "tool0", "structure": "RRR"}, "robot.structure",
+     "takes its joints from robot.urdf"),
+    ({"urdf": "ur10.urdf", "tool_link": "tool0"}, "robot.base_link", "needed"),
+    ({"urdf": "missing.urdf", "base_link": "a", "tool_link": "b"}, "robot.urdf", "no such file"),
+])
+def test_bad_urdf_robot_is_one_line(tmp_path, robot, key, reason):
+    (tmp_path / "ur10.urdf").write_text(UR10.read_text())
+    config = tmp_path / "c.yaml"
+    config.write_text(yaml.safe_dump({"robot": robot}))
+    result = CliRunner().invoke(app, ["check", str(config)])
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and f"{config}: {key}: " in lines[0] and reason in lines[0], result.output
+
+
+def test_not_a_urdf_is_one_line(tmp_path):
+    (tmp_path / "r.urdf").write_text("<robot name='x'><joint name='j' type='revolute'>")
+    config = tmp_path / "c.yaml"
+    config.write_text(yaml.safe_dump({"robot": {"urdf": "r.urdf", "base_link": "a", "tool_link": "b"}}))
+    result = CliRunner().invoke(app, ["check", str(config)])
+    assert result.exit_code == 2 and f"{tmp_path / 'r.urdf'}: (file): not a readable URDF" in result.output
+
+
+def test_ur10_placement_runs_tracks_and_reverifies(tmp_path):
+    cfg = yaml.safe_load((ROOT / "configs" / "ur10_placement.yaml").read_text())
+    cfg["robot"]["urdf"] = str(UR10)
+    cfg["toolpath"]["waypoints"] = 30
+    cfg["solver"] = {**cfg["solver"], "multistart": 2, "jobs": 1}
+    config = tmp_path / "ur10.yaml"
+    config.write_text(yaml.safe_dump(cfg))
+    result = CliRunner().invoke(app, ["run", str(config), "--out", str(tmp_path / "r"), "--name", "t", "--urdf"])
+    assert result.exit_code == 0, result.output
+    run = tmp_path / "r" / "ur10_placement" / "t"
+    best = json.loads((run / "best.json").read_text())
+    assert best["metrics"]["tracks"] and "ets" in best and "dh" not in best
+    for f in [run / "best.json", *(run / "solutions").glob("*.json")]:
+        assert verify_file(f) == [], f
+    # the exported cell loads in pinocchio with the solved tool pose at every waypoint
+    model = pin.buildModelFromUrdf(str(run / "export" / "best.urdf"))
+    data = model.createData()
+    frame = model.getFrameId("flange")
+    placement = best["placement"]
+    yaw, pitch, roll = placement["ypr"]
+    c, s = math.cos, math.sin
+    R_BW = (np.array([[c(yaw), -s(yaw), 0], [s(yaw), c(yaw), 0], [0, 0, 1]])
+            @ np.array([[c(pitch), 0, s(pitch)], [0, 1, 0], [-s(pitch), 0, c(pitch)]])
+            @ np.array([[1, 0, 0], [0, c(roll), -s(roll)], [0, s(roll), c(roll)]]))
+    for q, p_W in zip(best["q"], best["toolpath"]["points_W"], strict=True):
+        pin.framesForwardKinematics(model, data, np.array(q))
+        target = R_BW @ np.array(p_W) + np.array(placement["xyz"])
+        np.testing.assert_allclose(data.oMf[frame].translation, target, atol=1.1e-3)
+
+
+@pytest.mark.parametrize("command", ["continuous", "waypoints", "modular"])
+def test_dh_experiments_refuse_a_urdf_robot_with_one_line(command, tmp_path):
+    config = ROOT / "configs" / "ur10_placement.yaml"
+    result = CliRunner().invoke(app, [command, str(config), "--out", str(tmp_path)])
+    assert result.exit_code == 2 and f"{config}: robot.urdf: " in result.output, result.output
+    assert not any(tmp_path.iterdir()), "a run directory was left behind"
