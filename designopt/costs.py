@@ -1,20 +1,128 @@
-"""Cost terms of the design problem (SPEC §3), as pure functions over numpy or CasADi values.
+"""Cost terms of the design problem (SPEC §3), as pure functions over numpy or CasADi values, and the named,
+weighted terms a `DesignProblem` holds.
 
 * ``tracking``      L_t = |p - s_B|^2 + |z - z*|^2
 * ``compliance``    C(q) = J K^-1 J^T, 6 x 6, in the base frame
 * ``deformation``   L_d = |C w|^2 (full) or |(C w)_{1:3}|^2 (translational), w = (F, 0, 0, 0)
 * ``regularization`` L_r = lambda_r * sum of squared design lengths (Whitman et al.)
 * ``design_cost``   sum_k dt L_d(t_k): the number every method is compared on
+
+A problem's objective is a sum of named terms (crocoddyl's ``costs.addCost(name, cost, weight)``):
+`WaypointCost` ``sum_k dt * weight * fn(waypoint_k)`` integrated along the path, and `DesignCost`
+``weight * fn(chain, q_d)`` on the design joints alone. Each term's value before its weight is reported as
+``cost_<name>`` (in Metrics, summary.csv and the solution file). Adding a per-waypoint term is its function of
+a `Waypoint` and one `DesignProblem.with_cost` call; both transcriptions and the exact structured Hessian
+pick it up.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
+from designopt.kinematics.chain import geometric_jacobian, placement_pose, tool_pose
+from designopt.kinematics.joints import REGULARISED, Chain, Role
 from designopt.kinematics.transforms import is_symbolic
+
+
+@dataclass(frozen=True)
+class Waypoint:
+    """What a per-waypoint cost sees at one waypoint, numbers or CasADi symbols alike.
+
+    Frames: B (robot base) unless a name ends in _W (workpiece). ``q`` moving joints, ``q_d`` design joints,
+    ``T_BW`` the placement, ``p``/``z`` tool position (m) and tool axis, ``J`` the 6 x n_m geometric
+    Jacobian, ``s_W``/``f_W`` the waypoint (m) and its process force (N) in W, ``force`` that force in B,
+    ``k_inv`` the inverse joint stiffnesses, ``deflection`` full or translational.
+    """
+
+    q: object
+    q_d: object
+    T_BW: object
+    p: object
+    z: object
+    J: object
+    s_W: object
+    f_W: object
+    force: object
+    k_inv: np.ndarray
+    deflection: str
+
+    @property
+    def p_W(self):
+        """Tool position in W."""
+        R, t = self.T_BW[:3, :3], self.T_BW[:3, 3]
+        return R.T @ (self.p - t)
+
+    @property
+    def z_W(self):
+        """Tool axis in W."""
+        return self.T_BW[:3, :3].T @ self.z
+
+
+def waypoint(chain: Chain, q, q_d, s_W, f_W, k_inv, deflection: str) -> Waypoint:
+    """The state at one waypoint from the chain's kinematics (one walk for the pose, one for the Jacobian)."""
+    T_BW = placement_pose(chain, q, q_d)
+    T_BT = tool_pose(chain, q, q_d)
+    return Waypoint(q=q, q_d=q_d, T_BW=T_BW, p=T_BT[:3, 3], z=T_BT[:3, 2], J=geometric_jacobian(chain, q, q_d),
+                    s_W=s_W, f_W=f_W, force=T_BW[:3, :3] @ f_W, k_inv=k_inv, deflection=deflection)
+
+
+@dataclass(frozen=True)
+class WaypointCost:
+    """``sum_k dt * weight * fn(waypoint_k)``: a term integrated along the path (fn: Waypoint -> scalar)."""
+
+    name: str
+    weight: float
+    fn: Callable[[Waypoint], object]
+
+
+@dataclass(frozen=True)
+class DesignCost:
+    """``weight * fn(chain, q_d)``: a term on the design joints alone (numpy or CasADi).
+
+    ``quadratic`` terms (constant Hessian, like L_r) go into the NLP's constant Hessian part; the others are
+    spread evenly over the waypoints so that the per-waypoint Hessian blocks carry them.
+    """
+
+    name: str
+    weight: float
+    fn: Callable
+    quadratic: bool = False
+
+    def __call__(self, chain: Chain, q_d):
+        return self.weight * self.fn(chain, q_d)
+
+
+def sumsqr(x):
+    """Sum of squares of a vector, numpy or CasADi (for writing cost terms once for both)."""
+    if is_symbolic(x):
+        return ca.sumsqr(x)
+    x = np.asarray(x, dtype=float).ravel()
+    return float(x @ x)
+
+
+def deformation_term(w: Waypoint):
+    """L_d at a waypoint: the deformation cost of SPEC §3 (``design_cost`` is its integral)."""
+    return deformation(w.J, w.k_inv, w.force, w.deflection)
+
+
+def design_length_indices(chain: Chain) -> list[int]:
+    """Indices into q_d of the design joints tagged as regularised lengths (DH d and a, URDF origin xyz)."""
+    return [i for i, j in enumerate(j for j in chain.joints if j.role is Role.DESIGN) if REGULARISED in j.tags]
+
+
+def regularization_term(chain: Chain, q_d):
+    """sum of squared design lengths (m^2): Whitman et al.'s L_r before its weight lambda_r."""
+    index = design_length_indices(chain)
+    if not index:
+        return 0.0
+    if is_symbolic(q_d):
+        return ca.sumsqr(q_d[index])
+    lengths = np.asarray(q_d, dtype=float)[index]
+    return float(lengths @ lengths)
 
 DEFLECTION_MODES = ("full", "translational")
 

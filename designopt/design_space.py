@@ -109,8 +109,3 @@ def build_chain(
         frames.append(len(robot))
     return Chain(joints=tuple(joints), placement=placement_ets(0), robot=tuple(robot), frames=tuple(frames),
                  dh=tuple(links))
-
-
-def design_lengths(chain: Chain) -> list[int]:
-    """Indices into q_d of the design joints the regularisation penalises (tagged: link lengths d, a)."""
-    return [i for i, j in enumerate(chain.design) if REGULARISED in j.tags]

@@ -11,13 +11,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from designopt import costs
-from designopt.kinematics.chain import geometric_jacobian, placement_pose, tool_pose
+from designopt.costs import deformation_term
 from designopt.problem import DesignProblem
+
+Z_DOWN = np.array([0.0, 0.0, -1.0])  # the target tool axis in W: into the surface
 
 
 @dataclass(frozen=True)
 class Metrics:
-    """Per-solution figures. Lengths in metres; deformation per waypoint in the cost's units."""
+    """Per-solution figures. Lengths in metres; deformation per waypoint in the cost's units.
+
+    ``costs`` holds every named term of the problem's objective before its weight (name -> value):
+    integrals sum_k dt fn for waypoint terms, fn(q_d) for design terms. ``design_cost`` is the deformation
+    integral sum_k dt L_d that every method is compared on; ``regularization`` is lambda_r times the
+    regularisation term (its share of the objective).
+    """
 
     design_cost: float
     regularization: float
@@ -29,11 +37,11 @@ class Metrics:
     position_error: np.ndarray
     axis_error: np.ndarray
     min_standoff: float
-    design_costs: tuple[tuple[str, float], ...] = ()
+    costs: tuple[tuple[str, float], ...] = ()
 
     def row(self) -> dict:
         return {
-            **{f"cost_{name}": value for name, value in self.design_costs},
+            **{f"cost_{name}": value for name, value in self.costs},
             "design_cost": self.design_cost,
             "regularization": self.regularization,
             "max_position_error": self.max_position_error,
@@ -55,24 +63,19 @@ def max_joint_step(Q: np.ndarray) -> float:
 def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> Metrics:
     """Evaluate a design q_d (n_d) and joint waypoints Q (N x n_m) on the problem's toolpath."""
     chain, tp = problem.chain, problem.toolpath
-    T_BW = placement_pose(chain, Q[0], q_d)
-    R_BW, t_BW = T_BW[:3, :3], T_BW[:3, 3]
-    z_target = R_BW @ np.array([0.0, 0.0, -1.0])
-    k_inv = problem.k_inv
-    deform, pos_err, axis_err, standoff = [], [], [], []
-    for k in range(tp.n):
-        T = tool_pose(chain, Q[k], q_d)
-        s_B = R_BW @ tp.points_W[k] + t_BW
-        pos_err.append(np.linalg.norm(T[:3, 3] - s_B))
-        axis_err.append(np.linalg.norm(T[:3, 2] - z_target))
-        J = geometric_jacobian(chain, Q[k], q_d)
-        deform.append(costs.deformation(J, k_inv, R_BW @ tp.force_W[k], problem.deflection))
-        standoff.append(np.hypot(s_B[0], s_B[1]))
-    deform, pos_err, axis_err = np.array(deform), np.array(pos_err), np.array(axis_err)
+    q_d = np.asarray(q_d, dtype=float)
+    states = [problem.waypoint(Q[k], q_d, tp.points_W[k], tp.force_W[k]) for k in range(tp.n)]
+    deform = np.array([deformation_term(w) for w in states])
+    pos_err = np.array([np.linalg.norm(w.p_W - w.s_W) for w in states])
+    axis_err = np.array([np.linalg.norm(w.z_W - Z_DOWN) for w in states])
+    s_B = [w.T_BW[:3, :3] @ w.s_W + w.T_BW[:3, 3] for w in states]
+    values = {c.name: tp.dt * float(sum(c.fn(w) for w in states)) for c in problem.waypoint_costs}
+    values |= {c.name: float(c.fn(chain, q_d)) for c in problem.design_costs}
+    regularization = sum(c.weight * values[c.name] for c in problem.design_costs if c.name == "regularization")
     max_pos, max_axis = float(pos_err.max()), float(axis_err.max())
     return Metrics(
         design_cost=costs.design_cost(deform, tp.dt),
-        regularization=costs.regularization(np.asarray(q_d)[problem.regularized], problem.regularization),
+        regularization=float(regularization),
         max_position_error=max_pos,
         max_axis_error=max_axis,
         max_joint_step=max_joint_step(Q),
@@ -80,6 +83,6 @@ def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> Metrics:
         deformation=deform,
         position_error=pos_err,
         axis_error=axis_err,
-        min_standoff=float(min(standoff)),
-        design_costs=tuple((c.name, float(c(chain, np.asarray(q_d, float)))) for c in problem.design_costs),
+        min_standoff=float(min(np.hypot(s[0], s[1]) for s in s_B)),
+        costs=tuple(values.items()),
     )

@@ -5,39 +5,38 @@ Transcriptions (TO collocation, the FK baseline) take a `DesignProblem` and neve
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from designopt import toolpaths
 from designopt.config import Config, dh_rows
-from designopt.costs import Stiffness
-from designopt.design_space import JointBounds, build_chain, design_lengths, placement_ets, placement_joints
+from designopt.costs import (
+    DesignCost,
+    Stiffness,
+    Waypoint,
+    WaypointCost,
+    deformation_term,
+    regularization_term,
+    waypoint,
+)
+from designopt.design_space import JointBounds, build_chain, placement_ets, placement_joints
 from designopt.errors import InputError
 from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.joints import DH_PARAMS, Chain, Role
 
 
 @dataclass(frozen=True)
-class DesignCost:
-    """A named, weighted cost on the design joints only: weight * fn(chain, q_d) (numpy or CasADi)."""
-
-    name: str
-    weight: float
-    fn: Callable
-
-    def __call__(self, chain: Chain, q_d):
-        return self.weight * self.fn(chain, q_d)
-
-
-@dataclass(frozen=True)
 class DesignProblem:
     """Everything that defines the optimum, nothing about how it is found.
 
-    Units: metres, radians, newtons; task time t in [0, 1]. ``joint_velocity`` bounds |dq/dt| per unit
-    task time; ``position_tol`` (m) and ``axis_tol`` (norm of z - z*) define when a solution tracks.
+    Units: metres, radians, newtons; task time t in [0, 1]. The objective is the sum of the named, weighted
+    terms in ``waypoint_costs`` and ``design_costs`` (see `designopt.costs`), plus the trajectory
+    regularisers ``smoothness`` (weight of the integral of |q''|^2) and ``joint_regularization`` (weight of
+    sum_k dt |q_k|^2), plus ``tracking_weight`` * L_t when tracking is soft. ``joint_velocity`` bounds
+    |dq/dt| per unit task time; ``position_tol`` (m) and ``axis_tol`` (norm of z - z*) define when a
+    solution tracks.
     """
 
     name: str
@@ -45,26 +44,36 @@ class DesignProblem:
     toolpath: toolpaths.Toolpath
     stiffness: Stiffness
     deflection: str = "full"
-    deformation_weight: float = 1.0
+    waypoint_costs: tuple[WaypointCost, ...] = (WaypointCost("deformation", 1.0, deformation_term),)
+    design_costs: tuple[DesignCost, ...] = (DesignCost("regularization", 1.0e-3, regularization_term, True),)
     tracking_weight: float = 1.0e4
-    regularization: float = 1.0e-3
     smoothness: float = 1.0e-9
     joint_regularization: float = 1.0e-7
     joint_velocity: float = 10.0
     keep_out_radius: float = 0.0
     position_tol: float = 1.0e-3
     axis_tol: float = 1.0e-2
-    design_costs: tuple[DesignCost, ...] = ()
 
     @property
     def k_inv(self) -> np.ndarray:
         """Inverse stiffness of each moving joint, base to tool (rad/(N*m) or m/N)."""
         return 1.0 / self.stiffness.diagonal(self.chain.structure)
 
-    @property
-    def regularized(self) -> list[int]:
-        """Indices into q_d of the design lengths that the regularisation penalises."""
-        return design_lengths(self.chain)
+    def with_cost(self, cost: WaypointCost | DesignCost) -> DesignProblem:
+        """A copy with one more named term in the objective (a name already there is replaced)."""
+        if isinstance(cost, WaypointCost):
+            kept = tuple(c for c in self.waypoint_costs if c.name != cost.name)
+            return replace(self, waypoint_costs=(*kept, cost))
+        kept = tuple(c for c in self.design_costs if c.name != cost.name)
+        return replace(self, design_costs=(*kept, cost))
+
+    def without_cost(self, name: str) -> DesignProblem:
+        return replace(self, waypoint_costs=tuple(c for c in self.waypoint_costs if c.name != name),
+                       design_costs=tuple(c for c in self.design_costs if c.name != name))
+
+    def waypoint(self, q, q_d, s_W, f_W) -> Waypoint:
+        """The state a per-waypoint cost sees (numbers or CasADi symbols)."""
+        return waypoint(self.chain, q, q_d, s_W, f_W, self.k_inv, self.deflection)
 
 
 def toolpath_from_config(cfg: Config, base_dir: Path) -> toolpaths.Toolpath:
@@ -172,9 +181,11 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         toolpath=toolpath,
         stiffness=stiffness_from_config(cfg),
         deflection=cfg.costs.deflection,
-        deformation_weight=cfg.costs.deformation_weight,
+        # deformation_weight only rescales the objective (a unit choice for physical stiffness models, whose
+        # L_d is ~1e-8 m^2 and would otherwise be drowned by the regularisation); the reported cost is unscaled.
+        waypoint_costs=(WaypointCost("deformation", cfg.costs.deformation_weight, deformation_term),),
+        design_costs=(DesignCost("regularization", cfg.costs.regularization, regularization_term, quadratic=True),),
         tracking_weight=cfg.costs.tracking_weight,
-        regularization=cfg.costs.regularization,
         smoothness=cfg.costs.smoothness,
         joint_regularization=cfg.costs.joint_regularization,
         joint_velocity=cfg.robot.joint_velocity,

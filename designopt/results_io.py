@@ -21,8 +21,9 @@ SUMMARY_COLUMNS = [
     "design_cost", "max_position_error", "max_axis_error", "max_joint_step", "tracks", "best",
     "status", "success", "iterations", "solve_time_s", "build_time_s", "n_variables", "n_constraints",
     "objective", "regularization", "min_standoff", "kinematic_drift", "seed",
-    "stiffness_revolute", "stiffness_prismatic", "deflection", "cost_modular", "solution_file",
+    "stiffness_revolute", "stiffness_prismatic", "deflection", "solution_file",
 ]
+# ...plus one cost_<name> column per named term of the objective (before solution_file), as rows bring them.
 
 
 def default_run_name() -> str:
@@ -64,12 +65,23 @@ class RunDirectory:
 
     def append_row(self, row: dict) -> None:
         """Append one row to summary.csv (header with the first row) in one O_APPEND write, then fsync,
-        so a process killed at any moment leaves whole rows only."""
+        so a process killed at any moment leaves whole rows only. A row with a column the file does not have
+        yet (a new cost_<name>) first widens the file's header, atomically; no value is ever dropped."""
+        unknown = sorted(set(row) - set(SUMMARY_COLUMNS) - {k for k in row if k.startswith("cost_")})
+        if unknown:
+            raise ValueError(f"summary.csv has no column for {unknown}")
+        fieldnames, rows = self._read_rows()
+        new = not fieldnames
+        if new:
+            fieldnames = _columns(row)
+        elif set(row) - set(fieldnames):
+            fieldnames = _columns({**dict.fromkeys(fieldnames), **row})
+            self._rewrite(fieldnames, rows)
         buffer = io.StringIO()
-        writer = csv.DictWriter(buffer, fieldnames=SUMMARY_COLUMNS, extrasaction="ignore", lineterminator="\n")
-        if not self.summary.exists() or self.summary.stat().st_size == 0:
+        writer = csv.DictWriter(buffer, fieldnames=fieldnames, lineterminator="\n")
+        if new:
             writer.writeheader()
-        writer.writerow({k: _fmt(row.get(k, "")) for k in SUMMARY_COLUMNS})
+        writer.writerow({k: _fmt(row.get(k, "")) for k in fieldnames})
         fd = os.open(self.summary, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
         try:
             os.write(fd, buffer.getvalue().encode())
@@ -129,6 +141,12 @@ class RunDirectory:
         stamp = dt.datetime.now().isoformat(timespec="seconds")
         with (self.path / "run.log").open("a") as fh:
             fh.write(f"{stamp} {message}\n")
+
+
+def _columns(row: dict) -> list[str]:
+    """SUMMARY_COLUMNS with the row's cost_<name> columns before solution_file."""
+    base = [c for c in SUMMARY_COLUMNS if c != "solution_file"]
+    return [*base, *sorted(k for k in row if k.startswith("cost_")), "solution_file"]
 
 
 def _fmt(value):

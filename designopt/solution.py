@@ -130,6 +130,8 @@ def to_dict(sol: Solution) -> dict:
             "iterations": r.iterations,
             "solve_time_s": r.solve_time_s,
             "regularization": m.regularization,
+            "costs": {name: value for name, value in m.costs},
+            "cost_weights": {c.name: c.weight for c in (*p.waypoint_costs, *p.design_costs)},
             "min_standoff": m.min_standoff,
             "kinematic_drift": r.kinematic_drift,
             "objective": _finite(r.objective),

@@ -83,8 +83,8 @@ def test_the_resolve_keeps_modules_fixed():
         j = fixed.chain.joint(name)
         assert j.role is Role.FIXED and j.value == v
     assert fixed.chain.joint("placement.x").value == 0.7
-    assert fixed.design_costs == ()
-    assert with_modular_cost(problem, CAT, 1e-3).design_costs[0].name == "modular"
+    assert [c.name for c in fixed.design_costs] == ["regularization"]
+    assert [c.name for c in with_modular_cost(problem, CAT, 1e-3).design_costs] == ["regularization", "modular"]
 
 
 def test_catalogue_assumptions():

@@ -25,7 +25,7 @@ from designopt.kinematics.transforms import placement_transform
 from designopt.problem import problem_from_config
 from designopt.solution import solve_and_evaluate
 from designopt.transcriptions import Collocation
-from designopt.transcriptions.base import waypoint_function
+from designopt.transcriptions.nlp import waypoint_terms
 
 # ---------------------------------------------------------------------------------------------------------
 # Independent reference implementations (plain numpy, written from the SPEC's formulas)
@@ -220,8 +220,9 @@ def test_optimizer_and_evaluation_agree_with_reference_at_random_points(deflecti
                         "placement": {"xyz": [0.4, -0.3, 0.2], "ypr": [0.7, -0.4, 1.1]},
                         "costs": {"deflection": deflection}, "toolpath": {"kind": "circle", "waypoints": 9}})
     problem = problem_from_config(cfg)
-    chain = problem.chain
-    fn = waypoint_function(problem)
+    chain, h = problem.chain, problem.toolpath.dt
+    # the optimizer's per-waypoint function: phi = dt * L_d (+ nothing else here), c = (p_W - s_W, z_W)
+    terms, _, _ = waypoint_terms(problem, "hard")
     names = [j.name for j in chain.design]
     for _ in range(5):
         q = rng.uniform(-2, 2, chain.n_moving)
@@ -233,10 +234,11 @@ def test_optimizer_and_evaluation_agree_with_reference_at_random_points(deflecti
         placement = [values[f"placement.{p}"] for p in ("x", "y", "z", "yaw", "pitch", "roll")]
         p_ref, z_ref, L_ref = ref_waypoint(structure, dh, placement, q, s_W, f_W, [3.0, 0.2, 3, 3, 0.2, 3],
                                            deflection)
-        p_W, z_W, L_d, _, _ = fn(q, q_d, s_W, f_W)
-        np.testing.assert_allclose(np.array(p_W).ravel(), p_ref, atol=1e-12)
-        np.testing.assert_allclose(np.array(z_W).ravel(), z_ref, atol=1e-12)
-        assert float(L_d) == pytest.approx(L_ref, rel=1e-10)
+        phi, c = terms(np.r_[q, q_d], s_W, f_W)
+        c = np.array(c).ravel()
+        np.testing.assert_allclose(c[:3], p_ref - s_W, atol=1e-12)
+        np.testing.assert_allclose(c[3:6], z_ref, atol=1e-12)
+        assert float(phi) / h == pytest.approx(L_ref, rel=1e-10)
         # The evaluation (the reported numbers) at a one-waypoint path through the same point.
         tp = toolpaths.Toolpath("point", np.array([0.0, 1.0]), np.tile(s_W, (2, 1)), np.zeros((2, 3)),
                                 np.tile(f_W, (2, 1)))

@@ -14,6 +14,7 @@ from typer.testing import CliRunner
 
 from cli.main import app
 from designopt.config import parse_config
+from designopt.costs import design_length_indices
 from designopt.kinematics.chain import geometric_jacobian, tool_pose
 from designopt.problem import problem_from_config
 from designopt.verify import verify_file
@@ -60,7 +61,7 @@ def test_any_origin_component_is_a_design_joint_by_name():
     design = {j.name: j for j in problem.chain.design}
     assert {"elbow_joint.origin.z", "wrist_1_joint.origin.z"} <= set(design)
     assert design["elbow_joint.origin.z"].value == pytest.approx(0.612)  # the UR10's upper-arm length
-    assert problem.regularized  # design lengths are regularised like DH lengths
+    assert design_length_indices(problem.chain)  # design lengths are regularised like DH lengths
     # changing that design joint moves the tool by the change along the upper arm
     chain = problem.chain
     q = np.zeros(6)

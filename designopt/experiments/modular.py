@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from designopt.config import Config, ConfigError, dump_config
+from designopt.costs import DesignCost
 from designopt.evaluation import evaluate
 from designopt.experiments.continuous import case_config, method_transcription
 from designopt.experiments.run import multistart_from_config, transcription_from_config
@@ -26,7 +27,7 @@ from designopt.experiments.tasks import Task, multistart_tasks, record, solve_ta
 from designopt.kinematics.joints import Role
 from designopt.modular import Catalogue, check_catalogue, link_vectors, modular_cost, nearest_modules
 from designopt.multistart import best_solution
-from designopt.problem import DesignCost, DesignProblem, problem_from_config
+from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
 
@@ -41,8 +42,7 @@ def catalogue_from_config(cfg: Config) -> Catalogue:
 
 
 def with_modular_cost(problem: DesignProblem, catalogue: Catalogue, weight: float) -> DesignProblem:
-    cost = DesignCost("modular", weight, partial(modular_cost, catalogue=catalogue))
-    return replace(problem, design_costs=(*problem.design_costs, cost))
+    return problem.with_cost(DesignCost("modular", weight, partial(modular_cost, catalogue=catalogue)))
 
 
 def module_values(problem: DesignProblem, assignment: list[int], catalogue: Catalogue) -> dict[str, float]:
@@ -59,7 +59,7 @@ def fix_modules(problem: DesignProblem, assignment: list[int], catalogue: Catalo
     """The problem with every link fixed to its module; only placement (and trajectory) stay free."""
     values = module_values(problem, assignment, catalogue)
     chain = problem.chain.with_roles(dict.fromkeys(values, Role.FIXED), {**values, **placement})
-    return replace(problem, chain=chain, design_costs=())
+    return replace(problem, chain=chain).without_cost("modular")
 
 
 def rounded_solution(sol: Solution, assignment: list[int], catalogue: Catalogue) -> Solution:

@@ -7,8 +7,6 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from designopt import costs
-from designopt.kinematics.chain import geometric_jacobian, placement_pose, tool_pose
 from designopt.problem import DesignProblem
 
 
@@ -42,31 +40,24 @@ class RawResult:
 
 
 def waypoint_function(problem: DesignProblem) -> ca.Function:
-    """Kinematics and deformation at one waypoint, as a CasADi SX function.
+    """Kinematics at one waypoint, as a CasADi SX function.
 
     Inputs: q (n_m), q_d (n_d), s_W (3, waypoint in W), f_W (3, force in W).
     Outputs, all in the workpiece frame W so that the targets are constants:
-      p_W (3) tool position, z_W (3) tool axis, L_d deformation cost, rho2 squared distance of the
-      waypoint from the base z-axis (for the keep-out stand-off), Jv_W (3 x n_m) linear Jacobian in W.
+      p_W (3) tool position, z_W (3) tool axis, rho2 squared distance of the waypoint from the base z-axis
+      (for the keep-out stand-off), Jv_W (3 x n_m) linear Jacobian in W.
     """
     chain = problem.chain
     q = ca.SX.sym("q", chain.n_moving)
     q_d = ca.SX.sym("q_d", chain.n_design)
     s_W = ca.SX.sym("s_W", 3)
     f_W = ca.SX.sym("f_W", 3)
-    T_BW = placement_pose(chain, q, q_d)
-    T_BT = tool_pose(chain, q, q_d)
-    R_BW, t_BW = T_BW[:3, :3], T_BW[:3, 3]
-    p_W = R_BW.T @ (T_BT[:3, 3] - t_BW)
-    z_W = R_BW.T @ T_BT[:3, 2]
-    J = geometric_jacobian(chain, q, q_d)
-    L_d = costs.deformation(J, problem.k_inv, R_BW @ f_W, problem.deflection)
+    w = problem.waypoint(q, q_d, s_W, f_W)
+    R_BW, t_BW = w.T_BW[:3, :3], w.T_BW[:3, 3]
     s_B = R_BW @ s_W + t_BW
-    rho2 = s_B[0] ** 2 + s_B[1] ** 2
-    Jv_W = R_BW.T @ J[:3, :]
     return ca.Function(
-        "waypoint", [q, q_d, s_W, f_W], [p_W, z_W, L_d, rho2, Jv_W],
-        ["q", "q_d", "s_W", "f_W"], ["p_W", "z_W", "L_d", "rho2", "Jv_W"],
+        "waypoint", [q, q_d, s_W, f_W], [w.p_W, w.z_W, s_B[0] ** 2 + s_B[1] ** 2, R_BW.T @ w.J[:3, :]],
+        ["q", "q_d", "s_W", "f_W"], ["p_W", "z_W", "rho2", "Jv_W"],
     )
 
 

@@ -29,6 +29,7 @@ from designopt.transcriptions.nlp import (
     WaypointNLP,
     joint_regularization,
     once_only_rows,
+    quadratic_design_costs,
     waypoint_terms,
     y_indices,
 )
@@ -105,9 +106,7 @@ class CollocationNLP:
 
         Q0, V0, Q1, V1 = Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:]
         Q_mid, V_mid = hermite_midpoint(Q0, V0, Q1, V1, h)
-        quadratic = 0
-        if problem.regularized:
-            quadratic += problem.regularization * ca.sumsqr(q_d[problem.regularized])
+        quadratic = quadratic_design_costs(problem, q_d)
         # The smoothness term must stay small against the design cost: the figure-eight needs joint
         # accelerations of ~100 rad per unit task time squared, so 1e-6 already outweighed L_d (measured).
         accel = ca.sum1(ca.sum2(hermite_acceleration_integral(Q0, V0, Q1, V1, h)))
@@ -124,8 +123,8 @@ class CollocationNLP:
         if differential:
             P = Z[2 * n_m :, :]
             wp = waypoint_function(problem)
-            p_W, _, _, _, Jv = wp.map(N)(Q, ca.repmat(q_d, 1, N), S, F)
-            _, _, _, _, Jv_mid = wp.map(N - 1)(Q_mid, ca.repmat(q_d, 1, N - 1), S[:, :-1], F[:, :-1])
+            p_W, _, _, Jv = wp.map(N)(Q, ca.repmat(q_d, 1, N), S, F)
+            _, _, _, Jv_mid = wp.map(N - 1)(Q_mid, ca.repmat(q_d, 1, N - 1), S[:, :-1], F[:, :-1])
             pdot, pdot_mid = _pdot(Jv, V, n_m, N), _pdot(Jv_mid, V_mid, n_m, N - 1)
             cons.add(P[:, 0] - p_W[:, 0], 0.0, 0.0)
             cons.add(P[:, 1:] - P[:, :-1] - h / 6.0 * (pdot[:, :-1] + 4 * pdot_mid + pdot[:, 1:]), 0.0, 0.0)

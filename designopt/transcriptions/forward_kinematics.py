@@ -26,6 +26,7 @@ from designopt.transcriptions.nlp import (
     ConstraintList,
     WaypointNLP,
     joint_regularization,
+    quadratic_design_costs,
     waypoint_terms,
     y_indices,
 )
@@ -69,9 +70,7 @@ class ForwardKinematicsNLP:
         S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
         terms, c_lo, c_hi = waypoint_terms(problem, "epsilon", epsilon=self.epsilon)
         Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F)
-        quadratic = joint_regularization(problem, Q, h)
-        if problem.regularized:
-            quadratic += problem.regularization * ca.sumsqr(q_d[problem.regularized])
+        quadratic = joint_regularization(problem, Q, h) + quadratic_design_costs(problem, q_d)
         objective = ca.sum2(Phi) + quadratic
 
         cons = ConstraintList()

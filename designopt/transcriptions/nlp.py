@@ -105,48 +105,66 @@ def joint_regularization(problem: DesignProblem, Q, h: float):
     return problem.joint_regularization * h * ca.sumsqr(Q)
 
 
-def waypoint_terms(problem: DesignProblem, tracking: str, position_in_terms: bool = True, epsilon: float = 0.0):
+TRACKING_ACTIVATIONS = ("hard", "soft", "epsilon")
+
+
+def tracking(w, s_W, activation: str, weight_h: float, position: bool = True, epsilon: float = 0.0):
+    """The tracking residual r = (p_W - s_W, z_W - z*) at one waypoint under an activation.
+
+    ``hard``: r = 0 as equalities (the axis held as z_W = (0, 0, <= 0), whose sign excludes z = -z*);
+    ``soft``: weight_h * |r|^2 in the objective (the paper); ``epsilon``: |r|^2 <= epsilon (the FK baseline).
+    ``position`` False leaves the position out (differential kinematics tracks it as a state).
+    Returns (objective part, constraints, lower bounds, upper bounds).
+    """
+    r_p, z_W = w.p_W - s_W, w.z_W
+    if activation == "epsilon":
+        return 0, [ca.sumsqr(r_p) + ca.sumsqr(z_W - ca.DM(Z_DOWN))], [-np.inf], [epsilon]
+    if activation == "soft":
+        return weight_h * (ca.sumsqr(z_W - ca.DM(Z_DOWN)) + (ca.sumsqr(r_p) if position else 0)), [], [], []
+    if activation != "hard":
+        raise ValueError(f"tracking must be one of {TRACKING_ACTIVATIONS}, got {activation!r}")
+    c, lo, hi = ([r_p], [0.0] * 3, [0.0] * 3) if position else ([], [], [])
+    return 0, [*c, z_W], [*lo, 0.0, 0.0, -np.inf], [*hi, 0.0, 0.0, 0.0]
+
+
+def waypoint_terms(problem: DesignProblem, activation: str, position_in_terms: bool = True, epsilon: float = 0.0):
     """Cost phi_k and constraints c_k at one waypoint as a function of y_k = (q_k, q_d).
 
-    Returns the CasADi function (y, s_W, f_W) -> (phi, c) and the bounds of c. ``tracking`` is ``hard``
-    (position and axis equalities), ``soft`` (w L_t in phi) or ``epsilon`` (L_t <= epsilon, the FK
-    baseline). The position enters only when p = FK(q); in differential mode it is a state.
+    phi_k holds every `WaypointCost` (dt * weight * fn), every non-quadratic `DesignCost` spread evenly over the
+    waypoints (so that the per-waypoint blocks, and with them the exact structured Hessian, carry it) and,
+    when soft, the tracking penalty. Returns the CasADi function (y, s_W, f_W) -> (phi, c) and the bounds of
+    c. The position enters only when p = FK(q); in differential mode it is a state.
     """
     chain, tp = problem.chain, problem.toolpath
     n_m, n_d, h = chain.n_moving, chain.n_design, tp.dt
     y = ca.SX.sym("y", n_m + n_d)
     s_W, f_W = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3)
-    p_W, z_W, L_d, rho2, _ = waypoint_function(problem)(y[:n_m], y[n_m:], s_W, f_W)
-    # deformation_weight only rescales the objective (a unit choice for physical stiffness models, whose
-    # L_d is ~1e-8 m^2 and would otherwise be drowned by the regularisation); the reported cost is unscaled.
-    phi = h * problem.deformation_weight * L_d
-    # Costs on the design joints alone (e.g. L_mod) are spread evenly over the waypoints so that the
-    # per-waypoint blocks, and with them the exact structured Hessian, carry them too.
+    w = problem.waypoint(y[:n_m], y[n_m:], s_W, f_W)
+    phi = 0
+    for cost in problem.waypoint_costs:
+        phi += h * cost.weight * cost.fn(w)
     for cost in problem.design_costs:
-        phi += cost(problem.chain, y[n_m:]) / tp.n
-    c, lo, hi = [], [], []
-    if tracking == "epsilon":
-        c.append(ca.sumsqr(p_W - s_W) + ca.sumsqr(z_W - ca.DM(Z_DOWN)))
-        lo.append(-np.inf)
-        hi.append(epsilon)
-    elif tracking == "soft":
-        L_t = ca.sumsqr(z_W - ca.DM(Z_DOWN)) + (ca.sumsqr(p_W - s_W) if position_in_terms else 0)
-        phi += h * problem.tracking_weight * L_t
-    else:
-        if position_in_terms:
-            c.append(p_W - s_W)
-            lo += [0.0] * 3
-            hi += [0.0] * 3
-        c.append(z_W)  # (0, 0, <= 0): the axis points into the surface; the sign excludes z = -z*
-        lo += [0.0, 0.0, -np.inf]
-        hi += [0.0, 0.0, 0.0]
+        if not cost.quadratic:
+            phi += cost(problem.chain, y[n_m:]) / tp.n
+    penalty, c, lo, hi = tracking(w, s_W, activation, h * problem.tracking_weight, position_in_terms, epsilon)
+    phi += penalty
     if problem.keep_out_radius > 0:
-        c.append(rho2)
+        s_B = w.T_BW[:3, :3] @ s_W + w.T_BW[:3, 3]
+        c.append(s_B[0] ** 2 + s_B[1] ** 2)
         lo.append(problem.keep_out_radius**2)
         hi.append(np.inf)
     fn = ca.Function("terms", [y, s_W, f_W], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
                      ["y", "s_W", "f_W"], ["phi", "c"])
     return fn, np.array(lo), np.array(hi)
+
+
+def quadratic_design_costs(problem: DesignProblem, q_d):
+    """The quadratic design terms (e.g. L_r): their Hessian is constant and joins the NLP's constant part."""
+    total = 0
+    for cost in problem.design_costs:
+        if cost.quadratic:
+            total += cost(problem.chain, q_d)
+    return total
 
 
 def once_only_rows(problem: DesignProblem, tracking: str) -> np.ndarray:
@@ -160,5 +178,5 @@ def once_only_rows(problem: DesignProblem, tracking: str) -> np.ndarray:
         return np.zeros(0, dtype=int)
     chain = problem.chain
     q, q_d = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design)
-    _, z_W, _, _, _ = waypoint_function(problem)(q, q_d, ca.SX.zeros(3), ca.SX.zeros(3))
+    _, z_W, _, _ = waypoint_function(problem)(q, q_d, ca.SX.zeros(3), ca.SX.zeros(3))
     return np.array([3, 4, 5]) if not ca.depends_on(z_W, q) else np.zeros(0, dtype=int)
