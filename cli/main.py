@@ -94,18 +94,14 @@ def run(
                                                           "solve the rest.")] = False,
 ):
     """Solve one design problem (multistart TO) and write results/<experiment>/<run>/."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
     from designopt.experiments.run import run_experiment
 
     cfg = load(config)
-    with Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), console=err, transient=True) as progress:
-        task = progress.add_task(f"{cfg.name}: solving {cfg.solver.multistart} starts", total=cfg.solver.multistart)
-        result = run_experiment(cfg, config.parent, out_dir, name,
-                                on_solution=lambda _s: progress.advance(task), figures=not no_figures, resume=resume)
-    show(solutions_table(result.solutions, f"{cfg.name}: {cfg.robot.structure}, "
-                                           f"stiffness {result.solutions[0].problem.stiffness.describe()}"))
+    with Bar(f"{cfg.name}: solving") as bar:
+        result = run_experiment(cfg, config.parent, out_dir, name, bar, figures=not no_figures, resume=resume)
+    problem = result.solutions[0].problem
+    show(solutions_table(result.solutions, f"{cfg.name}: {problem.chain.structure}, "
+                                           f"stiffness {problem.stiffness.describe()}"))
     if result.best is None:
         out.print("[yellow]No start tracks the path within tolerance; see summary.csv for statuses.[/yellow]")
     else:
@@ -148,18 +144,39 @@ def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/
     out.print(f"a run solves {s.starts} start(s); nothing was solved")
 
 
-def _progress():
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
+class Bar:
+    """A rich progress bar that is an experiment's `Progress`: solves planned, solves done, how many track."""
 
-    return Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                    TextColumn("eta"), TimeRemainingColumn(), console=err, transient=True)
+    def __init__(self, label: str):
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
+
+        self.label, self.failed = label, 0
+        self.bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                            TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn(), console=err, transient=True)
+        self.task = self.bar.add_task(label, total=0)
+
+    def __enter__(self):
+        self.bar.__enter__()
+        return self
+
+    def __exit__(self, *exc):
+        return self.bar.__exit__(*exc)
+
+    def planned(self, solves: int, finished: int = 0) -> None:
+        total = self.bar.tasks[0].total or 0
+        self.bar.update(self.task, total=total + solves, advance=finished)
+
+    def solved(self, task, solution) -> None:
+        self.failed += not solution.metrics.tracks
+        where = " ".join(x for x in (task.case, task.problem.chain.structure) if x)
+        self.bar.update(self.task, advance=1, description=f"{self.label} {where}: {self.failed} not tracking")
 
 
 def _frame_table(frame, title: str) -> Table:
@@ -190,17 +207,8 @@ def continuous(
     from designopt.experiments.continuous import run_continuous
 
     cfg = load(config)
-    total = len(cfg.continuous.cases) * len(cfg.continuous.methods) * cfg.solver.multistart
-    failed = 0
-    with _progress() as progress:
-        task = progress.add_task("continuous: solving", total=total)
-
-        def done(case, sol):
-            nonlocal failed
-            failed += not sol.metrics.tracks
-            progress.update(task, advance=1, description=f"continuous: {failed} not tracking")
-
-        result = run_continuous(cfg, config.parent, out_dir, name, on_solution=done, resume=resume)
+    with Bar("continuous") as bar:
+        result = run_continuous(cfg, config.parent, out_dir, name, bar, resume=resume)
     cols = ["case", "method", "n_design_joints", "design_cost", "max_joint_step", "tracking_starts", "starts",
             "median_solve_time_s"]
     show(_frame_table(result.table[cols], "best tracking start per case and method"))
@@ -219,13 +227,10 @@ def waypoints(
     from designopt.experiments.waypoints import run_waypoint_study
 
     cfg = load(config)
-    total = len(cfg.continuous.waypoint_study) * cfg.solver.multistart
-    with _progress() as progress:
-        task = progress.add_task("waypoint study", total=total)
-        table = run_waypoint_study(cfg, config.parent, out_dir, name, resume=resume,
-                                   on_solution=lambda n, _s: progress.update(task, advance=1,
-                                                                             description=f"waypoint study N={n}"))
-    show(_frame_table(table, "waypoint study (TO, design + placement)"))
+    with Bar("waypoint study") as bar:
+        result = run_waypoint_study(cfg, config.parent, out_dir, name, bar, resume=resume)
+    show(_frame_table(result.table, "waypoint study (TO, design + placement)"))
+    out.print(f"results: {result.directory.path}")
 
 
 @app.command("sweep-structures")
@@ -244,37 +249,19 @@ def sweep_structures(
                                                                        "(none: a LocalCluster).")] = None,
 ):
     """Solve every kinematic structure over {R, P} with min..max joints (TO + multistart), in parallel."""
-    from designopt.experiments.sweep import best_per_dof, run_sweep
+    from designopt.experiments.sweep import run_sweep
 
-    if min_dof > max_dof:
-        fail(f"--min-dof {min_dof} is above --max-dof {max_dof}")
     if backend not in ("loky", "dask"):
         fail(f"--backend: expected loky or dask, got {backend!r}")
     cfg = load(config)
-    failed = 0
-    with _progress() as progress:
-        task = progress.add_task("structures", total=None)
-
-        def planned(p):
-            progress.update(task, total=len(p.tasks), description=f"{len(p.structures)} structures "
-                                                                  f"({p.skipped} solves already done)")
-
-        def done(sol):
-            nonlocal failed
-            failed += not sol.metrics.tracks
-            progress.update(task, advance=1, description=f"{sol.problem.chain.structure:>6}: {failed} not tracking")
-
-        run = run_sweep(cfg, config.parent, out_dir, name, min_dof, max_dof, jobs, resume, backend, scheduler,
-                        on_plan=planned, on_solution=done)
-    import pandas as pd
-
-    table = pd.read_csv(run.path / "table.csv")
-    solved = int(table["design_cost"].notna().sum())
-    out.print(f"{len(table)} structures solved, {solved} track the path; best per number of joints:")
-    best = best_per_dof(table)
-    show(_frame_table(best[["dof", "structure", "n_prismatic", "design_cost", "tracking_starts", "starts"]],
-                           "best structure per DOF"))
-    out.print(f"results: {run.path}")
+    with Bar("structures") as bar:
+        result = run_sweep(cfg, config.parent, out_dir, name, min_dof, max_dof, jobs, resume, backend, scheduler, bar)
+    tracking = int(result.table["design_cost"].notna().sum())
+    out.print(f"{result.structures} structures solved ({result.solved_now} solves now, {result.already_done} "
+              f"already done), {tracking} track the path; best per number of joints:")
+    show(_frame_table(result.best_per_dof[["dof", "structure", "n_prismatic", "design_cost", "tracking_starts",
+                                           "starts"]], "best structure per DOF"))
+    out.print(f"results: {result.directory.path}")
 
 
 @app.command()
@@ -289,10 +276,8 @@ def modular(
     from designopt.experiments.modular import run_modular
 
     cfg = load(config)
-    with _progress() as progress:
-        task = progress.add_task("modular", total=4 * cfg.solver.multistart)
-        result = run_modular(cfg, config.parent, out_dir, name, config_file=str(config), resume=resume,
-                             on_solution=lambda case, _s: progress.update(task, advance=1, description=case))
+    with Bar("modular") as bar:
+        result = run_modular(cfg, config.parent, out_dir, name, bar, resume=resume)
     show(_frame_table(result.table, "modular design: best tracking start per stage"))
     out.print(f"results: {result.directory.path}")
 
@@ -309,16 +294,15 @@ def modular_study(
     from designopt.experiments.modular import run_modular_study
 
     cfg = load(config)
-    with _progress() as progress:
-        task = progress.add_task("modular study", total=None)
-        weights, enum = run_modular_study(cfg, config.parent, out_dir, name, config_file=str(config), resume=resume,
-                                          on_solution=lambda case, _s: progress.update(task, advance=1,
-                                                                                       description=case))
-    show(_frame_table(weights, "L_mod weight study"))
+    with Bar("modular study") as bar:
+        result = run_modular_study(cfg, config.parent, out_dir, name, bar, resume=resume)
+    enum = result.enumeration
+    show(_frame_table(result.weights, "L_mod weight study"))
     show(_frame_table(enum.head(10), "best module assignments (small catalogue)"))
     picked = enum[enum["rounding_picked"]]
     if len(picked):
         out.print(f"rounding picked rank {int(picked['rank'].iloc[0])} of {len(enum)}")
+    out.print(f"results: {result.directory.path}")
 
 
 @app.command()

@@ -6,6 +6,7 @@ DH parameters, ``placement`` picks workpiece coordinates; both end up as design 
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -109,3 +110,9 @@ def build_chain(
         frames.append(len(robot))
     return Chain(joints=tuple(joints), placement=placement_ets(0), robot=tuple(robot), frames=tuple(frames),
                  dh=tuple(links))
+
+
+def enumerate_structures(min_dof: int = 1, max_dof: int = 6) -> list[str]:
+    """All strings over {R, P} with min_dof..max_dof letters: by length, then R before P at each place.
+    1..6 gives 2 + 4 + ... + 64 = 126."""
+    return ["".join(s) for n in range(min_dof, max_dof + 1) for s in itertools.product("RP", repeat=n)]

@@ -40,6 +40,24 @@ class Solution:
         values = dict(zip([j.name for j in self.problem.chain.design], self.raw.q_d, strict=True))
         return self.problem.chain.with_roles(dict.fromkeys(values, Role.FIXED), values)
 
+    def sample(self, t) -> np.ndarray:
+        """Joint values q(t) (len(t) x n_m) at task times t in [0, 1].
+
+        Between waypoints the trajectory is the C^1 cubic Hermite spline through (q_k, v_k) when the solution
+        has joint velocities (TO's knots); without them (the FK baseline) it is the straight line, which is
+        all that baseline defines.
+        """
+        tk, Q, V = self.problem.toolpath.t, np.asarray(self.raw.Q, float), self.raw.V
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        k = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
+        h = (tk[k + 1] - tk[k])[:, None]
+        s = (t[:, None] - tk[k][:, None]) / h
+        if V is None:
+            return Q[k] + s * (Q[k + 1] - Q[k])
+        V = np.asarray(V, float)
+        return ((2 * s**3 - 3 * s**2 + 1) * Q[k] + (s**3 - 2 * s**2 + s) * h * V[k]
+                + (-2 * s**3 + 3 * s**2) * Q[k + 1] + (s**3 - s**2) * h * V[k + 1])
+
     def row(self) -> dict:
         """One summary.csv row (without experiment/case columns, which the caller adds)."""
         structure = self.problem.chain.structure

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from designopt.config import load_config
-from designopt.experiments.run import multistart_from_config, transcription_from_config
+from designopt.experiments.adapters import multistart_from_config, transcription_for
 from designopt.multistart import solve_start
 from designopt.problem import problem_from_config
 from designopt.solution import to_dict
@@ -23,7 +23,7 @@ def test_default_job_reproduces_the_stored_solution():
     before = json.loads((ROOT / "tests" / "data" / "milling_seed0_before_refactor.json").read_text())
     cfg = load_config(ROOT / "configs" / "milling.yaml")
     problem = problem_from_config(cfg, ROOT / "configs")
-    sol = solve_start(problem, transcription_from_config(cfg), multistart_from_config(cfg), 0)
+    sol = solve_start(problem, transcription_for(cfg), multistart_from_config(cfg), 0)
     now = to_dict(sol)
     assert now["metrics"]["status"] == before["metrics"]["status"] == "Solve_Succeeded"
     assert now["metrics"]["design_cost"] == pytest.approx(before["metrics"]["design_cost"], rel=1e-6)

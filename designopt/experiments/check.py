@@ -14,7 +14,7 @@ import numpy as np
 
 from designopt.config import Config
 from designopt.costs import Stiffness
-from designopt.experiments.run import transcription_from_config
+from designopt.experiments.adapters import transcription_for
 from designopt.kinematics.joints import Joint
 from designopt.problem import problem_from_config
 
@@ -49,7 +49,7 @@ def check_config(cfg: Config, base_dir: Path) -> ProblemSummary:
     """
     problem = problem_from_config(cfg, base_dir)
     t0 = time.perf_counter()
-    nlp = replace(transcription_from_config(cfg), compile="none").build(problem)
+    nlp = replace(transcription_for(cfg), compile="none").build(problem)
     build = time.perf_counter() - t0
     chain, tp = problem.chain, problem.toolpath
     return ProblemSummary(

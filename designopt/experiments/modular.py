@@ -10,7 +10,6 @@ Stages, each written to summary.csv as a ``case``:
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -18,12 +17,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from designopt.config import Config, ConfigError, dump_config
+from designopt.config import Config, dump_config
 from designopt.costs import DesignCost
 from designopt.evaluation import evaluate
-from designopt.experiments.continuous import case_config, method_transcription
-from designopt.experiments.run import multistart_from_config, transcription_from_config
-from designopt.experiments.tasks import Task, multistart_tasks, record, solve_tasks
+from designopt.experiments.adapters import case_config, multistart_from_config, transcription_for, with_waypoints
+from designopt.experiments.tasks import Progress, Task, multistart_tasks, record, solve_tasks
 from designopt.kinematics.joints import Role
 from designopt.modular import Catalogue, check_catalogue, link_vectors, modular_cost, nearest_modules
 from designopt.multistart import best_solution
@@ -78,11 +76,10 @@ class ModularResult:
     assignment: list[int]
 
 
-def _stage(run, problem, transcription, settings, case, on_solution, resume) -> Solution | None:
+def _stage(run, problem, transcription, settings, case, progress, resume) -> Solution | None:
     """One stage: a multistart of one problem, written (and resumed) like every experiment."""
     tasks = multistart_tasks(case, transcription.name, problem, transcription, settings)
-    done = solve_tasks(run, tasks, "modular", settings.jobs, resume,
-                       on_solution=(lambda t, sol: on_solution(t.case, sol)) if on_solution else None)
+    done = solve_tasks(run, tasks, "modular", settings.jobs, resume, progress)
     return best_solution([sol for _, sol in done])
 
 
@@ -97,29 +94,28 @@ class _Setup:
 
 
 def _setup(cfg: Config, base_dir: Path, out_root: Path, experiment: str, run_name: str | None,
-           config_file: str, resume: bool) -> _Setup:
+           resume: bool) -> _Setup:
     """Catalogue (checked against the structure), run directory and the combined design + placement problem."""
     catalogue = catalogue_from_config(cfg)
     try:
         check_catalogue(cfg.robot.structure, catalogue)
     except ValueError as exc:
-        raise ConfigError(config_file, "robot.structure", str(exc)) from None
+        raise cfg.error("robot.structure", str(exc)) from None
     combined = case_config(cfg, "combined")
     base = problem_from_config(combined, base_dir)
     run = RunDirectory.create(out_root, experiment, run_name, resume)
     run.write_config(dump_config(cfg))
-    return _Setup(catalogue, run, multistart_from_config(cfg), combined, base, transcription_from_config(combined))
+    return _Setup(catalogue, run, multistart_from_config(cfg), combined, base, transcription_for(combined))
 
 
 def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                on_solution: Callable[[str, Solution], None] | None = None, figures: bool = True,
-                config_file: str = "<config>", resume: bool = False) -> ModularResult:
-    s = _setup(cfg, base_dir, out_root, "modular", run_name, config_file, resume)
+                progress: Progress | None = None, figures: bool = True, resume: bool = False) -> ModularResult:
+    s = _setup(cfg, base_dir, out_root, "modular", run_name, resume)
     catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
-    best = {"continuous": _stage(run, base, to, settings, "continuous", on_solution, resume)}
-    best["fk"] = _stage(run, base, method_transcription(combined_cfg, "fk"), settings, "fk", on_solution, resume)
+    best = {"continuous": _stage(run, base, to, settings, "continuous", progress, resume)}
+    best["fk"] = _stage(run, base, transcription_for(combined_cfg, "fk"), settings, "fk", progress, resume)
     continuous, assignment, modular = _round_and_resolve(run, base, to, settings, catalogue, cfg.modular.weight, "",
-                                                         on_solution, resume)
+                                                         progress, resume)
     best["continuous_modular"], best["modular"] = continuous, modular
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
@@ -149,10 +145,10 @@ def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | Non
     return ModularResult(run, table, assignment)
 
 
-def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, on_solution, resume):
+def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, progress, resume):
     """Stages 2-4 for one L_mod weight; returns (continuous best, assignment, modular best)."""
     continuous = _stage(run, with_modular_cost(base, catalogue, weight), to, settings, f"{tag}continuous_modular",
-                        on_solution, resume)
+                        progress, resume)
     if continuous is None:
         return None, [], None
     assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)
@@ -160,23 +156,29 @@ def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, on_solut
     placement = {j.name: float(v) for j, v in zip(base.chain.design, continuous.raw.q_d, strict=True)
                  if j.name in placed}
     modular = _stage(run, fix_modules(base, assignment, catalogue, placement), to, settings, f"{tag}modular",
-                     on_solution, resume)
+                     progress, resume)
     return continuous, assignment, modular
 
 
+@dataclass(frozen=True)
+class ModularStudyResult:
+    directory: RunDirectory
+    weights: pd.DataFrame  # one row per L_mod weight
+    enumeration: pd.DataFrame  # every assignment of the small catalogue, ranked; rounding's pick marked
+
+
 def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                      on_solution: Callable[[str, Solution], None] | None = None,
-                      config_file: str = "<config>", resume: bool = False) -> tuple[pd.DataFrame, pd.DataFrame]:
+                      progress: Progress | None = None, resume: bool = False) -> ModularStudyResult:
     """Beyond the paper: (a) how the L_mod weight changes the result; (b) on a small catalogue where every
     assignment can be solved, how far rounding lands from the best assignment."""
     import itertools
 
-    s = _setup(cfg, base_dir, out_root, "modular_study", run_name, config_file, resume)
+    s = _setup(cfg, base_dir, out_root, "modular_study", run_name, resume)
     catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
 
     weights = []
     for w in cfg.modular.weight_study:
-        cont, assignment, mod = _round_and_resolve(run, base, to, settings, catalogue, w, f"w{w:g}-", on_solution,
+        cont, assignment, mod = _round_and_resolve(run, base, to, settings, catalogue, w, f"w{w:g}-", progress,
                                                    resume)
         weights.append({"weight": w, "continuous_cost": cont.metrics.design_cost if cont else np.nan,
                         "L_mod": modular_cost(base.chain, cont.raw.q_d, catalogue) if cont else np.nan,
@@ -189,16 +191,16 @@ def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str
     subset = [k - 1 for k in cfg.modular.enumeration_modules]
     small = replace(catalogue, modules=tuple(catalogue.modules[k] for k in subset))
     n = cfg.modular.enumeration_waypoints
-    small_cfg = combined_cfg.model_copy(update={"toolpath": combined_cfg.toolpath.model_copy(update={"waypoints": n})})
+    small_cfg = with_waypoints(combined_cfg, n)
     small_base = problem_from_config(small_cfg, base_dir)
-    small_to = transcription_from_config(small_cfg)
+    small_to = transcription_for(small_cfg)
     _, rounded_assignment, rounded_best = _round_and_resolve(run, small_base, small_to, settings, small,
-                                                             cfg.modular.weight, "enum-", on_solution, resume)
+                                                             cfg.modular.weight, "enum-", progress, resume)
     placement = {j.name: j.value for j in small_base.chain.placement_joints if j.role is Role.DESIGN}
     rows = []
     for assignment in itertools.product(range(len(subset)), repeat=small_base.chain.n_links):
         best = _stage(run, fix_modules(small_base, list(assignment), small, placement), small_to, settings,
-                      "enum-" + "".join(str(subset[k] + 1) for k in assignment), on_solution, resume)
+                      "enum-" + "".join(str(subset[k] + 1) for k in assignment), progress, resume)
         rows.append({"assignment": " ".join(f"m{subset[k] + 1}" for k in assignment),
                      "design_cost": best.metrics.design_cost if best else np.nan,
                      "rounding_picked": list(assignment) == rounded_assignment})
@@ -207,4 +209,4 @@ def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str
     enum.to_csv(run.path / "enumeration.csv", index=False)
     run.log(f"rounding picked {rounded_assignment}, its re-solve cost "
             f"{rounded_best.metrics.design_cost if rounded_best else float('nan')}")
-    return weight_table, enum
+    return ModularStudyResult(run, weight_table, enum)

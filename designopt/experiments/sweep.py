@@ -8,8 +8,6 @@ so a killed sweep keeps what it finished and ``resume`` solves only the rest.
 
 from __future__ import annotations
 
-import itertools
-from collections.abc import Callable
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,25 +15,16 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.run import multistart_from_config, transcription_from_config
-from designopt.experiments.tasks import Task, multistart_tasks, solve_tasks
+from designopt.experiments.adapters import (
+    enumerate_structures,
+    multistart_from_config,
+    structure_config,
+    transcription_for,
+)
+from designopt.experiments.tasks import Progress, Task, multistart_tasks, solve_tasks
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
-from designopt.solution import Solution
-
-
-def enumerate_structures(min_dof: int = 1, max_dof: int = 6) -> list[str]:
-    """All strings over {R, P} with min_dof..max_dof letters: by length, then R before P at each place.
-    1..6 gives 2 + 4 + ... + 64 = 126."""
-    return ["".join(s) for n in range(min_dof, max_dof + 1) for s in itertools.product("RP", repeat=n)]
-
-
-def structure_config(cfg: Config, structure: str) -> Config:
-    """The sweep's config for one structure: generic start design, every link's d/theta, a, alpha free."""
-    if cfg.robot.is_urdf:
-        raise cfg.error("robot.urdf", "the structure sweep builds DH robots; a URDF robot has one structure")
-    robot = cfg.robot.model_copy(update={"structure": structure, "dh": "generic", "design": ["d", "a", "alpha"]})
-    return cfg.model_copy(update={"robot": robot})
+from designopt.tables import best_per_dof, structure_table
 
 
 @dataclass(frozen=True)
@@ -51,8 +40,7 @@ def plan(cfg: Config, base_dir: Path, structures: list[str], done: set) -> Sweep
     tasks = []
     for structure in structures:
         c = structure_config(cfg, structure)
-        tasks += multistart_tasks("sweep", "to", problem_from_config(c, base_dir), transcription_from_config(c),
-                                  settings)
+        tasks += multistart_tasks("sweep", "to", problem_from_config(c, base_dir), transcription_for(c), settings)
     todo = [t for t in tasks if t.key not in done]
     return SweepPlan(structures, todo, len(tasks) - len(todo))
 
@@ -86,22 +74,35 @@ def backend(name: str, scheduler: str | None, jobs: int):
             cluster.close()
 
 
+@dataclass(frozen=True)
+class SweepResult:
+    directory: RunDirectory
+    table: pd.DataFrame  # one row per structure
+    best_per_dof: pd.DataFrame
+    structures: int
+    solved_now: int
+    already_done: int
+
+
 def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None, min_dof: int = 1,
               max_dof: int = 6, jobs: int = -1, resume: bool = False, backend_name: str = "loky",
-              scheduler: str | None = None, on_plan: Callable[[SweepPlan], None] | None = None,
-              on_solution: Callable[[Solution], None] | None = None, figures: bool = True) -> RunDirectory:
-    run = RunDirectory.create(out_root, cfg.name, run_name, resume)  # results/<config name>/<run>, like every run
+              scheduler: str | None = None, progress: Progress | None = None, figures: bool = True) -> SweepResult:
+    """Every structure with min_dof..max_dof joints, solved with multistart TO into results/<config name>/<run>."""
+    if min_dof > max_dof:
+        raise cfg.error("--min-dof", f"{min_dof} is above --max-dof {max_dof}")
+    structures = enumerate_structures(min_dof, max_dof)
+    plan(cfg, base_dir, structures[:1], set())  # bad input stops here, before a run directory exists
+    run = RunDirectory.create(out_root, cfg.name, run_name, resume)
     run.write_config(dump_config(cfg))
-    sweep_plan = plan(cfg, base_dir, enumerate_structures(min_dof, max_dof), set(run.resume()) if resume else set())
-    run.log(f"sweep {min_dof}..{max_dof} DOF: {len(sweep_plan.structures)} structures, {len(sweep_plan.tasks)} "
+    sweep_plan = plan(cfg, base_dir, structures, set(run.resume()) if resume else set())
+    run.log(f"sweep {min_dof}..{max_dof} DOF: {len(structures)} structures, {len(sweep_plan.tasks)} "
             f"solves to do, {sweep_plan.skipped} already done")
-    if on_plan:
-        on_plan(sweep_plan)
+    if progress:
+        progress.planned(len(sweep_plan.tasks) + sweep_plan.skipped, sweep_plan.skipped)
     if sweep_plan.tasks:
         with backend(backend_name, scheduler, jobs):
             # the plan already left out finished solves; their rows stay, and the table reads them
-            solve_tasks(run, sweep_plan.tasks, cfg.name, jobs=None,
-                        on_solution=(lambda _t, sol: on_solution(sol)) if on_solution else None)
+            solve_tasks(run, sweep_plan.tasks, cfg.name, jobs=None, progress=_Solved(progress))
     table = structure_table(pd.read_csv(run.summary))
     table.to_csv(run.path / "table.csv", index=False)
     if figures:
@@ -109,29 +110,18 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
 
         plots_experiments.structure_figures(table, run.figures)
     run.log("done")
-    return run
+    return SweepResult(run, table, best_per_dof(table), len(structures), len(sweep_plan.tasks), sweep_plan.skipped)
 
 
-def best_per_dof(table: pd.DataFrame) -> pd.DataFrame:
-    """The lowest-cost tracking structure for each number of joints."""
-    tracking = table.dropna(subset=["design_cost"]).sort_values("design_cost")
-    return tracking.groupby("dof").head(1).sort_values("dof")
+class _Solved:
+    """Pass on finished solves only: the sweep announced its whole plan itself."""
 
+    def __init__(self, progress: Progress | None):
+        self.progress = progress
 
-def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
-    """One row per structure: best tracking start (cost NaN if none tracks), starts, statuses."""
-    rows = []
-    for structure, group in summary.groupby("structure", sort=False):
-        tracking = group[group["tracks"].astype(str) == "True"]
-        best = tracking.loc[tracking["design_cost"].idxmin()] if len(tracking) else None
-        rows.append({
-            "structure": structure, "dof": len(structure), "n_prismatic": structure.count("P"),
-            "design_cost": best["design_cost"] if best is not None else float("nan"),
-            "tracking_starts": len(tracking), "starts": len(group),
-            "statuses": ";".join(sorted(set(group["status"]))),
-            "best_solution": best["solution_file"] if best is not None else "",
-            "median_solve_time_s": group["solve_time_s"].median(),
-        })
-    table = pd.DataFrame(rows)
-    order = {s: i for i, s in enumerate(enumerate_structures(1, 12))}
-    return table.sort_values("structure", key=lambda c: c.map(order)).reset_index(drop=True)
+    def planned(self, solves: int, finished: int = 0) -> None:
+        pass
+
+    def solved(self, task, solution) -> None:
+        if self.progress:
+            self.progress.solved(task, solution)

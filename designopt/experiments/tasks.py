@@ -9,10 +9,11 @@ once (its solution file atomically, then its summary row), so a killed run keeps
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Protocol
 
-from designopt.multistart import Multistart, solve_start
+from designopt.multistart import Multistart, best_solution, solve_start
 from designopt.problem import DesignProblem
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, SolutionLoadError, read_solution_for, write_solution
@@ -44,6 +45,26 @@ class Task:
         return f"solutions/{self.case}-{stem}.json" if self.case else f"solutions/{stem}.json"
 
 
+class Progress(Protocol):
+    """What an experiment reports while it works (the CLI draws it; experiments never print)."""
+
+    def planned(self, solves: int, finished: int = 0) -> None:
+        """``solves`` more solves are planned, ``finished`` of them already done (resumed)."""
+
+    def solved(self, task: Task, solution: Solution) -> None:
+        """One solve finished and was written."""
+
+
+class Silent:
+    """A Progress that reports nothing."""
+
+    def planned(self, solves: int, finished: int = 0) -> None:
+        pass
+
+    def solved(self, task: Task, solution: Solution) -> None:
+        pass
+
+
 def multistart_tasks(case: str, method: str, problem: DesignProblem, transcription, settings: Multistart) -> list[Task]:
     return [Task(case, method, problem, transcription, settings, i) for i in range(settings.count)]
 
@@ -73,7 +94,7 @@ def record(run: RunDirectory, task: Task, sol: Solution, experiment: str) -> Non
 
 
 def solve_tasks(run: RunDirectory, tasks: list[Task], experiment: str, jobs: int | None = -1,
-                resume: bool = False, on_solution: Callable[[Task, Solution], None] | None = None,
+                resume: bool = False, progress: Progress | None = None,
                 load_finished: bool = True) -> list[tuple[Task, Solution]]:
     """Solve every task, writing each as it finishes; return (task, solution) for all of them.
 
@@ -99,9 +120,16 @@ def solve_tasks(run: RunDirectory, tasks: list[Task], experiment: str, jobs: int
             todo.append(task)
     if finished:
         run.log(f"resume: {len(tasks) - len(todo)} solves already done, {len(todo)} to do")
+    progress = progress or Silent()
+    progress.planned(len(tasks), len(tasks) - len(todo))
     for task, sol in fan_out(todo, jobs):
         record(run, task, sol, experiment)
         results.append((task, sol))
-        if on_solution:
-            on_solution(task, sol)
+        progress.solved(task, sol)
     return results
+
+
+def best_of(done: list[tuple[Task, Solution]]) -> tuple[Task | None, Solution | None]:
+    """(task, solution) of the tracking solution with the lowest design cost, or (None, None)."""
+    best = best_solution([sol for _, sol in done])
+    return next(((t, s) for t, s in done if s is best), (None, None))

@@ -1,60 +1,57 @@
 """Waypoint study: how the number of waypoints N changes design cost, tracking and solve time (TO, combined).
 
-Hard tracking is exact at the waypoints; what N controls is the path *between* them. The trajectory is
-the C^1 cubic Hermite interpolant, so the tracking error is measured at every interval midpoint against
-the path sampled there.
+Hard tracking is exact at the waypoints; what N controls is the path *between* them. The solution's
+trajectory (`Solution.sample`) is checked at every interval midpoint against the path sampled there.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.continuous import case_config
-from designopt.experiments.run import multistart_from_config, transcription_from_config
-from designopt.experiments.tasks import multistart_tasks, solve_tasks
+from designopt.experiments.adapters import case_config, multistart_from_config, transcription_for, with_waypoints
+from designopt.experiments.tasks import Progress, multistart_tasks, solve_tasks
 from designopt.kinematics.chain import placement_pose, tool_pose
 from designopt.multistart import best_solution
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution
-from designopt.transcriptions.collocation import hermite_midpoint
+
+
+@dataclass(frozen=True)
+class WaypointResult:
+    directory: RunDirectory
+    table: pd.DataFrame  # one row per N
 
 
 def midpoint_errors(sol: Solution, cfg: Config, base_dir: Path) -> np.ndarray:
-    """Position error (m) of the interpolated trajectory at every interval midpoint."""
-    N = sol.problem.toolpath.n
-    fine = problem_from_config(cfg.model_copy(update={"toolpath": cfg.toolpath.model_copy(
-        update={"waypoints": 2 * N - 1})}), base_dir).toolpath
-    Q, V, h = sol.raw.Q, sol.raw.V, sol.problem.toolpath.dt
-    Q_mid, _ = hermite_midpoint(Q[:-1], V[:-1], Q[1:], V[1:], h)
-    chain = sol.chain
-    T_BW = placement_pose(chain, Q[0], np.zeros(0))
-    errors = []
-    for k, q in enumerate(Q_mid):
-        s_B = T_BW[:3, :3] @ fine.points_W[2 * k + 1] + T_BW[:3, 3]
-        errors.append(np.linalg.norm(tool_pose(chain, q, np.zeros(0))[:3, 3] - s_B))
-    return np.array(errors)
+    """Position error (m) of the solution's trajectory at every interval midpoint."""
+    tp = sol.problem.toolpath
+    fine = problem_from_config(with_waypoints(cfg, 2 * tp.n - 1), base_dir).toolpath
+    chain, none = sol.chain, np.zeros(0)
+    Q_mid = sol.sample(0.5 * (tp.t[:-1] + tp.t[1:]))
+    T_BW = placement_pose(chain, Q_mid[0], none)
+    s_B = fine.points_W[1::2] @ T_BW[:3, :3].T + T_BW[:3, 3]
+    return np.array([np.linalg.norm(tool_pose(chain, q, none)[:3, 3] - s) for q, s in zip(Q_mid, s_B, strict=True)])
 
 
 def run_waypoint_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                       on_solution: Callable[[int, Solution], None] | None = None,
-                       figures: bool = True, resume: bool = False) -> pd.DataFrame:
+                       progress: Progress | None = None, figures: bool = True,
+                       resume: bool = False) -> WaypointResult:
     base = case_config(cfg, "combined")
     problem_from_config(base, base_dir)  # bad input stops here, before a run directory exists
     run = RunDirectory.create(out_root, "waypoints", run_name, resume)
     run.write_config(dump_config(cfg))
     rows = []
     for n in cfg.continuous.waypoint_study:
-        c = base.model_copy(update={"toolpath": base.toolpath.model_copy(update={"waypoints": n})})
+        c = with_waypoints(base, n)
         problem, settings = problem_from_config(c, base_dir), multistart_from_config(c)
-        tasks = multistart_tasks(f"N{n}", "to", problem, transcription_from_config(c), settings)
-        done = solve_tasks(run, tasks, "waypoints", settings.jobs, resume,
-                           on_solution=(lambda _t, sol, n=n: on_solution(n, sol)) if on_solution else None)
+        done = solve_tasks(run, multistart_tasks(f"N{n}", "to", problem, transcription_for(c), settings), "waypoints",
+                           settings.jobs, resume, progress)
         sols = [sol for _, sol in done]
         best = best_solution(sols)
         mid = midpoint_errors(best, c, base_dir) if best else np.array([np.nan])
@@ -75,4 +72,4 @@ def run_waypoint_study(cfg: Config, base_dir: Path, out_root: Path, run_name: st
 
         plots_experiments.waypoint_figure(table, run.figures)
     run.log("done")
-    return table
+    return WaypointResult(run, table)

@@ -34,15 +34,19 @@ from designopt.transcriptions.nlp import (
 
 @dataclass(frozen=True)
 class ForwardKinematics:
-    """The FK baseline as a transcription of the same DesignProblem as TO."""
+    """The FK baseline as a transcription of the same DesignProblem as TO. ``hessian``: ``structured`` (exact,
+    from per-waypoint blocks) or ``auto`` (CasADi differentiates the whole graph)."""
 
     continuous: bool = False
     epsilon: float | None = None
     max_iter: int = 3000
     compile: str = "O0"
+    hessian: str = "structured"
     ipopt: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        if self.hessian not in ("structured", "auto"):
+            raise ValueError(f"hessian must be structured or auto, got {self.hessian!r}")
         if self.compile not in COMPILE_MODES:
             raise ValueError(f"compile must be one of {COMPILE_MODES}, got {self.compile!r}")
 
@@ -84,8 +88,8 @@ class ForwardKinematicsNLP:
         hi_m = [j.upper for j in chain.moving]
         lbx = np.concatenate([[j.lower for j in chain.design], np.tile(lo_m, N)])
         ubx = np.concatenate([[j.upper for j in chain.design], np.tile(hi_m, N)])
-        blocks = BlockStructure(terms, y_indices(n_d, n_m, N, n_m), np.arange(N * n_c).reshape(N, n_c),
-                                scheme.compile)
+        blocks = None if scheme.hessian == "auto" else BlockStructure(
+            terms, y_indices(n_d, n_m, N, n_m), np.arange(N * n_c).reshape(N, n_c), scheme.compile)
         self.nlp = WaypointNLP(problem, scheme.name, x, objective, quadratic, cons, lbx, ubx, blocks,
                                scheme.max_iter, scheme.ipopt, t0)
         self.n_variables, self.n_constraints = self.nlp.n_variables, self.nlp.n_constraints

@@ -1,0 +1,57 @@
+"""Tables of results (pandas): the best tracking solve per case and method, per structure, per number of
+joints. Computed from solutions or from summary.csv; plots draw them, the CLI prints them."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from designopt.design_space import enumerate_structures
+from designopt.multistart import best_solution
+
+CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
+
+
+def best_table(solutions: dict) -> pd.DataFrame:
+    """One row per (case, method): the best tracking start and how many starts tracked."""
+    rows = []
+    for (case, method), sols in solutions.items():
+        best = best_solution(sols)
+        tracking = [s for s in sols if s.metrics.tracks]
+        rows.append({
+            "case": case, "method": method, "n_design_joints": sols[0].problem.chain.n_design,
+            "design_cost": best.metrics.design_cost if best else float("nan"),
+            "max_joint_step": best.metrics.max_joint_step if best else float("nan"),
+            "max_position_error": best.metrics.max_position_error if best else float("nan"),
+            "starts": len(sols), "tracking_starts": len(tracking),
+            "median_cost_tracking": pd.Series([s.metrics.design_cost for s in tracking]).median(),
+            "median_solve_time_s": pd.Series([s.raw.solve_time_s for s in sols]).median(),
+            "median_iterations": pd.Series([s.raw.iterations for s in sols]).median(),
+            "best_seed": best.raw.seed if best else None,
+        })
+    order = {c: i for i, c in enumerate(CASE_LABELS)}
+    return pd.DataFrame(rows).sort_values(["case", "method"], key=lambda c: c.map(order) if c.name == "case" else c)
+
+
+def best_per_dof(table: pd.DataFrame) -> pd.DataFrame:
+    """The lowest-cost tracking structure for each number of joints."""
+    tracking = table.dropna(subset=["design_cost"]).sort_values("design_cost")
+    return tracking.groupby("dof").head(1).sort_values("dof")
+
+
+def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
+    """One row per structure: best tracking start (cost NaN if none tracks), starts, statuses."""
+    rows = []
+    for structure, group in summary.groupby("structure", sort=False):
+        tracking = group[group["tracks"].astype(str) == "True"]
+        best = tracking.loc[tracking["design_cost"].idxmin()] if len(tracking) else None
+        rows.append({
+            "structure": structure, "dof": len(structure), "n_prismatic": structure.count("P"),
+            "design_cost": best["design_cost"] if best is not None else float("nan"),
+            "tracking_starts": len(tracking), "starts": len(group),
+            "statuses": ";".join(sorted(set(group["status"]))),
+            "best_solution": best["solution_file"] if best is not None else "",
+            "median_solve_time_s": group["solve_time_s"].median(),
+        })
+    table = pd.DataFrame(rows)
+    order = {s: i for i, s in enumerate(enumerate_structures(1, 12))}
+    return table.sort_values("structure", key=lambda c: c.map(order)).reset_index(drop=True)
