@@ -313,10 +313,10 @@ def export(
 ):
     """Write the designed cell as URDF (robot + placed workpiece + toolpath) and the joint trajectory."""
     from designopt.export import export as export_cell
-    from designopt.verify import load_verified
+    from designopt.solution import Solution, to_dict
 
-    data = load_verified(solution)
-    paths = export_cell(data, out_dir or solution.parent / "export", stem=solution.stem)
+    sol = Solution.from_file(solution)
+    paths = export_cell(to_dict(sol), out_dir or solution.parent / "export", stem=solution.stem)
     for p in paths:
         out.print(f"wrote {p}")
 
@@ -332,14 +332,14 @@ def render(
 ):
     """Draw the robot following its path (PNG + PDF), optionally animated."""
     from designopt.plots import render_animation, render_figure, save
-    from designopt.verify import load_verified
+    from designopt.solution import Solution
 
-    data = load_verified(solution)
+    sol = Solution.from_file(solution)
     target = out_dir or solution.parent
-    for p in save(render_figure(data, frames), target, f"{solution.stem}_render"):
+    for p in save(render_figure(sol, frames), target, f"{solution.stem}_render"):
         out.print(f"wrote {p}")
     if animate:
-        out.print(f"wrote {render_animation(data, target / f'{solution.stem}_render.gif')}")
+        out.print(f"wrote {render_animation(sol, target / f'{solution.stem}_render.gif')}")
 
 
 def main() -> None:

@@ -113,11 +113,9 @@ def solution_figures(sol: Solution, directory: Path) -> list[Path]:
     return out
 
 
-def render_figure(data: dict, frames: int = 6):
-    """The robot of a solution file drawn at ``frames`` waypoints along its path (lighter = earlier)."""
-    from designopt.solution import chain_from_file
-
-    chain, Q, pts = chain_from_file(data), np.array(data["q"]), np.array(data["toolpath"]["points_W"])
+def render_figure(sol: Solution, frames: int = 6):
+    """The robot of a solution drawn at ``frames`` waypoints along its path (lighter = earlier)."""
+    chain, Q, pts, t = sol.chain, sol.raw.Q, sol.problem.toolpath.points_W, sol.problem.toolpath.t
     picks = np.linspace(0, len(Q) - 1, frames).round().astype(int)
     fig = plt.figure(figsize=(6, 5.5))
     ax = fig.add_subplot(projection="3d")
@@ -126,21 +124,19 @@ def render_figure(data: dict, frames: int = 6):
     for n, k in enumerate(picks):
         drawn.append(draw_robot(ax, chain, Q[k], pts if n == 0 else None,
                                 color=cmap(0.35 + 0.65 * n / max(frames - 1, 1)),
-                                label=f"t = {data['toolpath']['t'][k]:.2f}"))
+                                label=f"t = {t[k]:.2f}"))
     _equal_3d(ax, np.vstack(drawn + [np.zeros((1, 3))]))
     _label_axes(ax)
-    ax.set_title(f"{data['structure']} ({data['method']}): design cost {data['metrics']['design_cost']:.3g}")
+    ax.set_title(f"{chain.structure} ({sol.method}): design cost {sol.metrics.design_cost:.3g}")
     ax.legend(loc="upper left", fontsize=6)
     return fig
 
 
-def render_animation(data: dict, path: Path, fps: int = 15) -> Path:
+def render_animation(sol: Solution, path: Path, fps: int = 15) -> Path:
     """An animation of the robot following its path (GIF through Pillow, or MP4 if ffmpeg is present)."""
     from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
-    from designopt.solution import chain_from_file
-
-    chain, Q, pts = chain_from_file(data), np.array(data["q"]), np.array(data["toolpath"]["points_W"])
+    chain, Q, pts, t = sol.chain, sol.raw.Q, sol.problem.toolpath.points_W, sol.problem.toolpath.t
     fig = plt.figure(figsize=(5, 5))
     ax = fig.add_subplot(projection="3d")
     limits = np.vstack([draw_robot(ax, chain, q, pts) for q in Q[:: max(1, len(Q) // 8)]] + [np.zeros((1, 3))])
@@ -153,7 +149,7 @@ def render_animation(data: dict, path: Path, fps: int = 15) -> Path:
         ax.scatter(*s_B[k], color="C3", s=25)
         _equal_3d(ax, limits)
         _label_axes(ax)
-        ax.set_title(f"t = {data['toolpath']['t'][k]:.2f}")
+        ax.set_title(f"t = {t[k]:.2f}")
 
     anim = FuncAnimation(fig, frame, frames=len(Q))
     if path.suffix == ".mp4" and FFMpegWriter.isAvailable():

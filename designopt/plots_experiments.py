@@ -110,7 +110,7 @@ def structure_figures(table: pd.DataFrame, directory: Path) -> list[Path]:
             _ranked_bars(ax, rows, f"{dof}-DOF structures with three prismatic joints, ranked")
             paths += save(fig, directory, stem)
     if len(table):
-        from designopt.experiments.sweep import best_per_dof
+        from designopt.tables import best_per_dof
 
         best = best_per_dof(table)
         fig, ax = plt.subplots(figsize=(5, 3.2))

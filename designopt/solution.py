@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from designopt.costs import Stiffness
 from designopt.evaluation import Metrics, evaluate
 from designopt.kinematics.joints import DH_PARAMS, Chain, Role
 from designopt.problem import DesignProblem
@@ -39,6 +40,50 @@ class Solution:
         """The problem's chain with every design joint fixed at its solved value (only q moves)."""
         values = dict(zip([j.name for j in self.problem.chain.design], self.raw.q_d, strict=True))
         return self.problem.chain.with_roles(dict.fromkeys(values, Role.FIXED), values)
+
+    @classmethod
+    def from_file(cls, path) -> Solution:
+        """Read a solution file that is well formed and checks out (`designopt.verify.load_verified`)."""
+        from designopt.verify import load_verified
+
+        return cls.from_dict(load_verified(path), path, checked=True)
+
+    @classmethod
+    def from_dict(cls, data: dict, file="<solution>", checked: bool = False) -> Solution:
+        """A solution file's content as a Solution: the solved chain (design joints fixed), its toolpath,
+        stiffness, tolerances and trajectory; metrics recomputed. The file's shape is checked by the one schema
+        check (`designopt.verify.check_schema`; skipped if ``checked``); SolutionFileError if it fails."""
+        from designopt.toolpaths import Toolpath
+        from designopt.verify import check_schema
+
+        if not checked:
+            check_schema(data, file)
+        chain = chain_from_file(data)
+        tp = data["toolpath"]
+        force = np.array(tp["force_W"], dtype=float)
+        norms = np.linalg.norm(force, axis=1, keepdims=True)
+        points = np.array(tp["points_W"], dtype=float)
+        t = np.array(tp.get("t", np.linspace(0, 1, len(points))), dtype=float)
+        toolpath = Toolpath(tp.get("kind", "file"), t, points, np.divide(force, norms, where=norms > 0,
+                                                                       out=np.zeros_like(force)), force)
+        k = dict(zip(chain.structure, data["stiffness"], strict=True))  # the two-value model: one per joint type
+        m = data["metrics"]
+        tol = m.get("tolerances", {})
+        limits = data.get("joint_limits") or [{}]
+        problem = DesignProblem(name=data.get("method", "file"), chain=chain, toolpath=toolpath,
+                                stiffness=Stiffness(k.get("R", 1.0), k.get("P", 1.0)), deflection=m["deflection"],
+                                position_tol=tol.get("position", 1e-3), axis_tol=tol.get("axis", 1e-2),
+                                joint_velocity=float(limits[0].get("velocity_per_task_time", 10.0)))
+        Q = np.array(data["q"], dtype=float)
+        V = np.array(data["v"], dtype=float) if "v" in data else None
+        objective = m.get("objective")
+        raw = RawResult(q_d=np.zeros(0), Q=Q, V=V, status=str(m.get("status", "unknown")),
+                        success=bool(m.get("success", False)), iterations=int(m.get("iterations", 0)),
+                        solve_time_s=float(m.get("solve_time_s", 0.0)), build_time_s=float(m.get("build_time_s", 0.0)),
+                        objective=float("nan") if objective is None else float(objective),
+                        n_variables=int(m.get("n_variables", 0)), n_constraints=int(m.get("n_constraints", 0)),
+                        seed=int(m.get("seed", 0)), kinematic_drift=float(m.get("kinematic_drift", 0.0)))
+        return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, Q))
 
     def sample(self, t) -> np.ndarray:
         """Joint values q(t) (len(t) x n_m) at task times t in [0, 1].
@@ -234,4 +279,7 @@ def chain_from_file(data: dict) -> Chain:
             if moving:
                 frames.append(len(robot))
         chain = Chain(tuple(joints), placement_ets(0), tuple(robot), tuple(frames))
-    return replace(chain, tool=tuple(tuple(float(v) for v in r) for r in data["tool"]))
+    limits = iter(data.get("joint_limits") or [])
+    joints = tuple(replace(j, lower=float(lim["lower"]), upper=float(lim["upper"]))
+                   if j.role is Role.MOVING and (lim := next(limits, None)) is not None else j for j in chain.joints)
+    return replace(chain, joints=joints, tool=tuple(tuple(float(v) for v in r) for r in data["tool"]))

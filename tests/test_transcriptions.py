@@ -1,0 +1,90 @@
+"""Every transcription in the registry, on the same problems: the known optimum of a tiny problem, a failed
+solve returned as a result, and the exact structured Hessian equal to CasADi's own. And solutions: a file
+round-trips through Solution.from_dict, and Solution.sample is the trajectory between waypoints."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+from conftest import gantry_config
+
+from designopt.config import parse_config
+from designopt.initial_guess import initial_guesses
+from designopt.problem import problem_from_config
+from designopt.solution import Solution, solve_and_evaluate, to_dict
+from designopt.transcriptions import TRANSCRIPTIONS, transcription_named
+
+METHODS = sorted(TRANSCRIPTIONS)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_known_optimum(method):
+    """A Cartesian gantry with K = I: C w = (F, 0) at every pose, so L_d = alpha^2 and the design cost is
+    alpha^2 N / (N - 1) whatever the design (alpha = 2 here)."""
+    problem = problem_from_config(parse_config(gantry_config()))
+    nlp = transcription_named(method, max_iter=300).build(problem)
+    sol = solve_and_evaluate(problem, method, nlp.solve(initial_guesses(problem, 1, 0, 0.3, "constant")[0]))
+    N = problem.toolpath.n
+    assert sol.raw.success, sol.raw.status
+    assert sol.metrics.tracks
+    assert sol.metrics.design_cost == pytest.approx(4.0 * N / (N - 1), rel=1e-9)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_a_failed_solve_is_a_result(method, gantry_problem):
+    nlp = transcription_named(method, max_iter=1).build(gantry_problem)
+    raw = nlp.solve(initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0])
+    sol = solve_and_evaluate(gantry_problem, method, raw)
+    assert not raw.success and raw.status == "Maximum_Iterations_Exceeded"
+    assert sol.row()["status"] == "Maximum_Iterations_Exceeded" and sol.row()["iterations"] == 1
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_structured_hessian_equals_casadi(method, rng):
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 6},
+           "robot": {"structure": "RPRR", "dh": "generic", "stiffness": {"revolute": 2.0, "prismatic": 0.5}},
+           "placement": {"xyz": [0.4, 0.1, 0.0], "keep_out_radius": 0.1}}
+    problem = problem_from_config(parse_config(cfg))
+    ours = transcription_named(method, hessian="structured", compile="none").build(problem)
+    ref = transcription_named(method, hessian="auto").build(problem)
+    assert (ours.n_variables, ours.n_constraints) == (ref.n_variables, ref.n_constraints)
+    H_ours, H_ref = ours.nlp.solver.get_function("nlp_hess_l"), ref.nlp.solver.get_function("nlp_hess_l")
+    for _ in range(3):
+        x, lam_g = rng.normal(size=ours.n_variables), rng.normal(size=ours.n_constraints)
+        np.testing.assert_allclose(np.triu(np.array(ca.DM(H_ours(x, [], 0.7, lam_g)))),
+                                   np.triu(np.array(ca.DM(H_ref(x, [], 0.7, lam_g)))), rtol=1e-9, atol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def solved():
+    cfg = parse_config({"toolpath": {"kind": "circle", "radius": 0.08, "waypoints": 10},
+                        "robot": {"structure": "RRPRRR", "dh": "generic", "stiffness": {"revolute": 3.0,
+                                                                                       "prismatic": 0.5}},
+                        "placement": {"xyz": [0.35, 0.1, -0.1], "ypr": [0.3, 0.0, 0.0]}})
+    problem = problem_from_config(cfg)
+    raw = transcription_named("to", max_iter=300).build(problem).solve(initial_guesses(problem, 1, 0, 0.3)[0])
+    return solve_and_evaluate(problem, "to", raw)
+
+
+def test_solution_round_trips_through_its_file(solved):
+    data = to_dict(solved)
+    back = Solution.from_dict(data)
+    assert back.metrics.design_cost == pytest.approx(solved.metrics.design_cost, rel=1e-12)
+    assert back.metrics.max_position_error == pytest.approx(solved.metrics.max_position_error, abs=1e-15)
+    again = to_dict(back)
+    for key in ("structure", "dh", "tool", "placement", "stiffness", "q", "v", "joint_limits"):
+        assert again[key] == data[key], key
+    np.testing.assert_allclose(again["toolpath"]["force_W"], data["toolpath"]["force_W"], atol=1e-15)
+
+
+def test_sample_is_the_hermite_trajectory(solved):
+    tp, Q, V = solved.problem.toolpath, solved.raw.Q, solved.raw.V
+    np.testing.assert_allclose(solved.sample(tp.t), Q, atol=1e-12)
+    # Between waypoints k and k+1: the cubic through (q_k, v_k) and (q_k+1, v_k+1), solved directly.
+    k, frac = 3, 0.3
+    h = tp.t[k + 1] - tp.t[k]
+    A = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [1, h, h**2, h**3], [0, 1, 2 * h, 3 * h**2]])
+    for j in range(Q.shape[1]):
+        c = np.linalg.solve(A, [Q[k, j], V[k, j], Q[k + 1, j], V[k + 1, j]])
+        assert solved.sample(tp.t[k] + frac * h)[0, j] == pytest.approx(np.polyval(c[::-1], frac * h), abs=1e-12)
