@@ -13,7 +13,7 @@ from typing import Annotated, Literal
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, field_validator
 
-from designopt.errors import InputError
+from designopt.errors import InputError, read_text
 from designopt.kinematics.joints import DH_PARAMS, PLACEMENT_PARAMS
 from designopt.kinematics.presets import PRESETS
 
@@ -313,12 +313,7 @@ def parse_config(data: object, file: str | Path = "<config>", base_dir: Path | N
 def load_config(path: str | Path) -> Config:
     """Read, parse and validate a YAML config file."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise ConfigError(path, "(file)", "no such file") from None
-    except OSError as exc:
-        raise ConfigError(path, "(file)", f"cannot read: {exc.strerror or exc}") from None
+    text = read_text(path, ConfigError)
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:

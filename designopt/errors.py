@@ -19,3 +19,16 @@ class InputError(Exception):
 
 class InputWarning(UserWarning):
     """An input designopt repaired (e.g. a repeated CSV point dropped): worth telling the user, not fatal."""
+
+
+def read_text(path: str | Path, error: type[InputError] = InputError) -> str:
+    """A user's text file (a config, a toolpath): its content, or one-line ``error`` saying why not."""
+    path = Path(path)
+    try:
+        return path.read_text()
+    except FileNotFoundError:
+        raise error(path, "(file)", "no such file") from None
+    except UnicodeDecodeError:
+        raise error(path, "(file)", "not a text file") from None
+    except OSError as exc:
+        raise error(path, "(file)", f"cannot read: {exc.strerror or exc}") from None

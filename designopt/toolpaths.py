@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from designopt.errors import InputError, InputWarning
+from designopt.errors import InputError, InputWarning, read_text
 
 
 class ToolpathError(ValueError):
@@ -116,13 +116,7 @@ def read_csv(path: Path) -> np.ndarray:
     an `InputWarning` (a CAM export often repeats the point where a segment ends and the next begins).
     """
     path = Path(path)
-    try:
-        text = path.read_text()
-    except UnicodeDecodeError:
-        raise InputError(path, "(file)", "not a text file") from None
-    except OSError as exc:
-        raise InputError(path, "(file)", f"cannot read: {exc.strerror or exc}") from None
-    reader = csv.reader(text.splitlines())
+    reader = csv.reader(read_text(path).splitlines())
     header, columns, points, lines = None, None, [], []
     try:
         for row in reader:
