@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # The tests that guard the objective; each mutation runs them with -x (stop at the first failure).
 TESTS = ["tests/test_objective_truth.py", "tests/test_costs_and_toolpaths.py", "tests/test_kinematics.py",
-         "tests/test_collocation.py", "tests/test_fk.py", "tests/test_cli_and_files.py"]
+         "tests/test_collocation.py", "tests/test_fk.py", "tests/test_cli_and_files.py", "tests/test_urdf.py"]
 
 
 @dataclass(frozen=True)
@@ -42,7 +42,9 @@ MUTATIONS = [
              "return Toolpath(kind, t, points, tangents, force * tangents)",
              "return Toolpath(kind, t, points, tangents, -force * tangents)"),
     Mutation("dt dropped from the objective's deformation term", "designopt/transcriptions/nlp.py",
-             "phi = h * problem.deformation_weight * L_d", "phi = problem.deformation_weight * L_d"),
+             "phi += h * cost.weight * cost.fn(w)", "phi += cost.weight * cost.fn(w)"),
+    Mutation("a waypoint term's weight ignored", "designopt/transcriptions/nlp.py",
+             "phi += h * cost.weight * cost.fn(w)", "phi += h * cost.fn(w)"),
     Mutation("K instead of K^-1 (problem)", "designopt/problem.py",
              "return 1.0 / self.stiffness.diagonal(self.chain.structure)",
              "return self.stiffness.diagonal(self.chain.structure)"),
@@ -61,10 +63,12 @@ MUTATIONS = [
     Mutation("translational deflection takes the rotational rows", "designopt/costs.py",
              "delta = delta[:3]", "delta = delta[3:]"),
     Mutation("prismatic Jacobian column as if revolute-like", "designopt/kinematics/chain.py",
-             "lin, ang = z, 0 * z", "lin, ang = 0 * z, z"),
-    Mutation("regularisation dropped from the TO objective", "designopt/transcriptions/collocation.py",
-             "quadratic += problem.regularization * ca.sumsqr(q_d[problem.regularized])",
-             "quadratic += 0.0 * ca.sumsqr(q_d[problem.regularized])"),
+             "else (a, 0 * a)", "else (0 * a, a)"),
+    Mutation("regularisation dropped from the objective", "designopt/transcriptions/nlp.py",
+             "total += cost(problem.chain, q_d)", "total += 0 * cost(problem.chain, q_d)"),
+    Mutation("rotation about a general axis turned the wrong way", "designopt/kinematics/transforms.py",
+             "[c + x * x * v, x * y * v - z * s, x * z * v + y * s, 0],",
+             "[c + x * x * v, x * y * v + z * s, x * z * v + y * s, 0],"),
     Mutation("smoothness integral off by the interval length", "designopt/transcriptions/collocation.py",
              "return h / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)", "return 1 / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)"),
 ]
