@@ -149,7 +149,7 @@ class SolverConfig(_Strict):
     max_iter: Annotated[int, Field(ge=1)] = 3000
     jobs: Annotated[int, Field(ge=-1)] = -1  # -1: every core; 0 is rejected in _semantic_errors
     perturbation: Annotated[float, Field(ge=0)] = 0.3
-    init: Literal["ik", "constant"] = "ik"
+    init: Literal["reach", "ik", "constant"] = "ik"
     compile: Literal["none", "O0", "O1", "O2"] = "O0"
     time_limit: Positive = 300.0
 

@@ -3,8 +3,11 @@
 A start perturbs the design joints around their configured values and picks a joint configuration;
 ``ik`` mode then walks the path waypoint by waypoint with a damped least-squares inverse kinematics,
 each waypoint warm-started from the previous one, so the start trajectory is continuous (one IK branch)
-and tracks as well as the start design allows. ``constant`` mode holds that configuration at every
-waypoint and leaves tracking to the solver.
+and tracks as well as the start design allows. ``reach`` does the same, but when the start design cannot
+follow the path it first moves the design joints (placement and robot alike) the least it takes to reach
+it -- IK over the design joints too (`reach`) -- because a start that is far from feasible costs IPOPT
+hundreds of iterations of restoration. ``constant`` holds the configuration at every waypoint and leaves
+tracking to the solver.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ from designopt.kinematics.chain import geometric_jacobian, placement_pose, tool_
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
-INIT_MODES = ("ik", "constant")
+INIT_MODES = ("reach", "ik", "constant")
 
 
 def perturbed_design(problem: DesignProblem, rng: np.random.Generator, scale: float) -> np.ndarray:
@@ -53,6 +56,27 @@ def ik_residual(problem: DesignProblem, q: np.ndarray, q_d: np.ndarray, k: int):
     return r, np.vstack([R_WB @ J[:3, :], R_WB @ Jz])
 
 
+def _ik_point(problem: DesignProblem, q_d: np.ndarray, q: np.ndarray, k: int, iterations: int, lo=None,
+              hi=None) -> np.ndarray:
+    """Damped least-squares IK at waypoint k from q."""
+    if lo is None:
+        lo = np.array([j.lower for j in problem.chain.moving])
+        hi = np.array([j.upper for j in problem.chain.moving])
+    damping = 1e-2
+    r, J = ik_residual(problem, q, q_d, k)
+    for _ in range(iterations):
+        step = np.linalg.solve(J.T @ J + damping * np.eye(len(q)), -J.T @ r)
+        trial = np.clip(q + step, lo, hi)
+        r_new, J_new = ik_residual(problem, trial, q_d, k)
+        if r_new @ r_new < r @ r:
+            q, r, J, damping = trial, r_new, J_new, max(damping / 3, 1e-6)
+        else:
+            damping *= 5
+        if r @ r < 1e-14:
+            break
+    return q
+
+
 def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, iterations: int = 30) -> np.ndarray:
     """Damped least-squares IK along the path, each waypoint starting from the previous solution."""
     lo = np.array([j.lower for j in problem.chain.moving])
@@ -60,20 +84,61 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     Q = np.empty((problem.toolpath.n, len(q0)))
     q = np.array(q0, dtype=float)
     for k in range(problem.toolpath.n):
-        damping = 1e-2
-        r, J = ik_residual(problem, q, q_d, k)
-        for _ in range(iterations if k == 0 else max(8, iterations // 3)):
-            step = np.linalg.solve(J.T @ J + damping * np.eye(len(q)), -J.T @ r)
-            trial = np.clip(q + step, lo, hi)
-            r_new, J_new = ik_residual(problem, trial, q_d, k)
-            if r_new @ r_new < r @ r:
-                q, r, J, damping = trial, r_new, J_new, max(damping / 3, 1e-6)
-            else:
-                damping *= 5
-            if r @ r < 1e-14:
-                break
+        q = _ik_point(problem, q_d, q, k, iterations if k == 0 else max(8, iterations // 3), lo, hi)
         Q[k] = q
     return Q
+
+
+def reach(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations: int = 60, samples=None):
+    """A design near ``q_d`` and a trajectory near ``Q`` that follow the path: IK over the design joints too.
+
+    Design joints are joints: a damped least-squares IK on the tracking residuals at every waypoint, with the
+    design joints shared by all waypoints and kept within their bounds, starting from the IK walk ``Q`` (so
+    the trajectory stays on its branch). The damping keeps the design near the start (so starts stay
+    diverse). Returns (q_d, Q).
+    """
+    chain = problem.chain
+    ks = np.arange(problem.toolpath.n) if samples is None else np.asarray(samples)
+    N, n_m, n_d = len(ks), chain.n_moving, chain.n_design
+    lo = np.concatenate([[j.lower for j in chain.design], np.tile([j.lower for j in chain.moving], N)])
+    hi = np.concatenate([[j.upper for j in chain.design], np.tile([j.upper for j in chain.moving], N)])
+    fn = _residual_function(problem).map(N)
+    S = problem.toolpath.points_W[ks].T
+    rows = np.arange(6 * N).reshape(N, 6)
+
+    def evaluate(z):
+        r, J_q, J_d = fn(z[n_d:].reshape(N, n_m).T, np.tile(z[:n_d, None], (1, N)), S)
+        J_q, J_d = np.array(J_q), np.array(J_d)
+        J = np.zeros((6 * N, n_d + n_m * N))
+        for k in range(N):
+            J[rows[k], :n_d] = J_d[:, n_d * k : n_d * (k + 1)]
+            J[rows[k], n_d + n_m * k : n_d + n_m * (k + 1)] = J_q[:, n_m * k : n_m * (k + 1)]
+        return np.array(r).T.ravel(), J
+
+    z = np.concatenate([q_d, np.asarray(Q, dtype=float)[ks].ravel()])
+    r, J = evaluate(z)
+    damping = 1e-2
+    for _ in range(iterations):
+        if r @ r < 1e-14:
+            break
+        trial = np.clip(z + np.linalg.solve(J.T @ J + damping * np.eye(len(z)), -J.T @ r), lo, hi)
+        r_new, J_new = evaluate(trial)
+        if r_new @ r_new < r @ r:
+            z, r, J, damping = trial, r_new, J_new, max(damping / 3, 1e-6)
+        else:
+            damping *= 5
+    return z[:n_d], z[n_d:].reshape(N, n_m)
+
+
+def _residual_function(problem: DesignProblem):
+    """(q, q_d, s_W) -> tracking residual (p_W - s_W, z_W - (0, 0, -1)) and its Jacobians in q and q_d."""
+    import casadi as ca
+
+    chain = problem.chain
+    q, q_d, s_W = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design), ca.SX.sym("s_W", 3)
+    w = problem.waypoint(q, q_d, s_W, ca.SX.zeros(3))
+    r = ca.vertcat(w.p_W - s_W, w.z_W - ca.DM([0.0, 0.0, -1.0]))
+    return ca.Function("reach", [q, q_d, s_W], [r, ca.jacobian(r, q), ca.jacobian(r, q_d)])
 
 
 def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik") -> InitialGuess:
@@ -84,8 +149,27 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
     rng = np.random.default_rng([seed, index])
     q_d = problem.chain.design_values if index == 0 else perturbed_design(problem, rng, scale)
     q0 = random_configuration(problem, rng)
-    Q = ik_trajectory(problem, q_d, q0) if mode == "ik" else np.tile(q0, (problem.toolpath.n, 1))
+    if mode == "constant":
+        return InitialGuess(q_d=q_d, Q=np.tile(q0, (problem.toolpath.n, 1)), seed=seed * 1000 + index)
+    Q = ik_trajectory(problem, q_d, q0)
+    if mode == "reach" and problem.chain.n_design and not tracks(problem, q_d, Q):
+        # first the design, from a few waypoints spread along the path; then the walk with it; then, if some
+        # waypoints still miss, design and trajectory together from that walk
+        samples = np.unique(np.linspace(0, problem.toolpath.n - 1, 8).round().astype(int))
+        q_d, _ = reach(problem, q_d, Q, samples=samples)
+        Q = ik_trajectory(problem, q_d, q0)
+        if not tracks(problem, q_d, Q):
+            q_d, Q = reach(problem, q_d, Q)
     return InitialGuess(q_d=q_d, Q=Q, seed=seed * 1000 + index)
+
+
+def tracks(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> bool:
+    """Whether joint values Q with design q_d follow the path within the problem's tolerances."""
+    for k, q in enumerate(Q):
+        r = ik_residual(problem, q, q_d, k)[0]
+        if np.linalg.norm(r[:3]) > problem.position_tol or np.linalg.norm(r[3:]) > problem.axis_tol:
+            return False
+    return True
 
 
 def initial_guesses(problem: DesignProblem, count: int, seed: int, scale: float, mode: str = "ik"):

@@ -138,3 +138,22 @@ def test_each_start_depends_only_on_seed_and_index(gantry_problem):
     np.testing.assert_array_equal(many[2].Q, one.Q)
     np.testing.assert_array_equal(many[2].q_d, one.q_d)
     assert one.seed == 7002
+
+
+def test_reach_moves_the_design_joints_until_the_start_reaches_the_path():
+    """Design only, workpiece fixed: the perturbed design of start 1 cannot follow the path (its IK walk misses
+    by centimetres); `reach` (IK over the design joints too) finds a design near it that tracks, inside bounds."""
+    from designopt.initial_guess import initial_guess, tracks
+
+    cfg = parse_config({"toolpath": {"kind": "figure_eight", "waypoints": 30},
+                        "placement": {"optimize": False, "xyz": [0.45, 0.0, -0.2]}})
+    problem = problem_from_config(cfg)
+    plain, reached = initial_guess(problem, 1, 0, 0.3, "ik"), initial_guess(problem, 1, 0, 0.3, "reach")
+    assert not tracks(problem, plain.q_d, plain.Q)
+    assert tracks(problem, reached.q_d, reached.Q)
+    lo, hi = np.array([j.lower for j in problem.chain.design]), np.array([j.upper for j in problem.chain.design])
+    assert np.all(reached.q_d >= lo) and np.all(reached.q_d <= hi)
+    assert np.linalg.norm(reached.q_d - plain.q_d) < 1.0  # moved, but stays a start of its own
+    # start 0 already tracks: reach leaves it exactly as it was
+    a, b = initial_guess(problem, 0, 0, 0.3, "ik"), initial_guess(problem, 0, 0, 0.3, "reach")
+    np.testing.assert_array_equal(a.Q, b.Q)
