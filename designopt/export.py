@@ -90,12 +90,12 @@ def _ets_robot(data: dict, limits: list, links: list, joints: list, material) ->
     joint's origin. Returns the name of the last link."""
     import yourdfpy as y
 
-    from designopt.verify import _rotation, _translation
+    from designopt.verify import rotation, translation
 
     parent, fixed, i = BASE, np.eye(4), 0
     for et in data["ets"]:
         if et["value"] is not None:
-            step = _rotation if et["motion"] == "rotate" else _translation
+            step = rotation if et["motion"] == "rotate" else translation
             fixed = fixed @ step(et["axis"], et["value"])
             continue
         i += 1

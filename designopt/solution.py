@@ -74,16 +74,8 @@ class Solution:
                                 stiffness=Stiffness(k.get("R", 1.0), k.get("P", 1.0)), deflection=m["deflection"],
                                 position_tol=tol.get("position", 1e-3), axis_tol=tol.get("axis", 1e-2),
                                 joint_velocity=float(limits[0].get("velocity_per_task_time", 10.0)))
-        Q = np.array(data["q"], dtype=float)
-        V = np.array(data["v"], dtype=float) if "v" in data else None
-        objective = m.get("objective")
-        raw = RawResult(q_d=np.zeros(0), Q=Q, V=V, status=str(m.get("status", "unknown")),
-                        success=bool(m.get("success", False)), iterations=int(m.get("iterations", 0)),
-                        solve_time_s=float(m.get("solve_time_s", 0.0)), build_time_s=float(m.get("build_time_s", 0.0)),
-                        objective=float("nan") if objective is None else float(objective),
-                        n_variables=int(m.get("n_variables", 0)), n_constraints=int(m.get("n_constraints", 0)),
-                        seed=int(m.get("seed", 0)), kinematic_drift=float(m.get("kinematic_drift", 0.0)))
-        return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, Q))
+        raw = _raw_from_file(data, np.zeros(0))
+        return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, raw.Q))
 
     def sample(self, t) -> np.ndarray:
         """Joint values q(t) (len(t) x n_m) at task times t in [0, 1].
@@ -238,26 +230,30 @@ def read_solution_for(problem: DesignProblem, method: str, path: Path, label: st
     try:
         data = json.loads(Path(path).read_text())
         names = [j.name for j in problem.chain.design]
-        q_d = np.array([data["design_joints"][n] for n in names], dtype=float)
-        Q = np.array(data["q"], dtype=float)
-        V = np.array(data["v"], dtype=float) if "v" in data else None
-        m = data["metrics"]
-        if set(data["design_joints"]) != set(names) or Q.shape != (problem.toolpath.n, problem.chain.n_moving):
+        raw = _raw_from_file(data, np.array([data["design_joints"][n] for n in names], dtype=float))
+        if set(data["design_joints"]) != set(names) or raw.Q.shape != (problem.toolpath.n, problem.chain.n_moving):
             raise SolutionLoadError(f"{path}: written for another problem")
-        if method == "to" and V is None:
+        if method == "to" and raw.V is None:
             raise SolutionLoadError(f"{path}: no joint velocities (written before they were stored)")
-        objective = m.get("objective")
-        raw = RawResult(q_d=q_d, Q=Q, V=V, status=str(m["status"]), success=bool(m.get("success", False)),
-                        iterations=int(m["iterations"]), solve_time_s=float(m["solve_time_s"]),
-                        build_time_s=float(m.get("build_time_s", 0.0)),
-                        objective=float("nan") if objective is None else float(objective),
-                        n_variables=int(m.get("n_variables", 0)), n_constraints=int(m.get("n_constraints", 0)),
-                        seed=int(m["seed"]), kinematic_drift=float(m.get("kinematic_drift", 0.0)))
     except (OSError, ValueError, KeyError, TypeError) as exc:
         if isinstance(exc, SolutionLoadError):
             raise
         raise SolutionLoadError(f"{path}: {exc}") from None
-    return Solution(problem, method, raw, evaluate(problem, q_d, Q), label)
+    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.Q), label)
+
+
+def _raw_from_file(data: dict, q_d: np.ndarray) -> RawResult:
+    """The solver's answer as a solution file records it (its metrics block), with these design joints."""
+    m = data["metrics"]
+    objective = m.get("objective")
+    return RawResult(q_d=q_d, Q=np.array(data["q"], dtype=float),
+                     V=np.array(data["v"], dtype=float) if "v" in data else None,
+                     status=str(m.get("status", "unknown")), success=bool(m.get("success", False)),
+                     iterations=int(m.get("iterations", 0)), solve_time_s=float(m.get("solve_time_s", 0.0)),
+                     build_time_s=float(m.get("build_time_s", 0.0)),
+                     objective=float("nan") if objective is None else float(objective),
+                     n_variables=int(m.get("n_variables", 0)), n_constraints=int(m.get("n_constraints", 0)),
+                     seed=int(m.get("seed", 0)), kinematic_drift=float(m.get("kinematic_drift", 0.0)))
 
 
 def chain_from_file(data: dict) -> Chain:

@@ -163,13 +163,13 @@ def _rot(axis, angle):
     return R
 
 
-def _translation(axis, value):
+def translation(axis, value):
     T = np.eye(4)
     T[:3, 3] = np.asarray(axis, dtype=float) * value
     return T
 
 
-def _rotation(axis, angle):
+def rotation(axis, angle):
     """Rodrigues: rotation by angle about the unit axis."""
     k = np.asarray(axis, dtype=float)
     K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
@@ -200,7 +200,7 @@ def _robot_walk(data: dict, q) -> tuple:
             origins.append(T[:3, 3].copy())
             axes.append(T[:3, :3] @ np.asarray(et["axis"], dtype=float))
             kinds.append("R" if et["motion"] == "rotate" else "P")
-        T = T @ (_rotation(et["axis"], value) if et["motion"] == "rotate" else _translation(et["axis"], value))
+        T = T @ (rotation(et["axis"], value) if et["motion"] == "rotate" else translation(et["axis"], value))
     return T, origins, axes, kinds
 
 
