@@ -102,6 +102,9 @@ def run(
     problem = result.solutions[0].problem
     show(solutions_table(result.solutions, f"{cfg.name}: {problem.chain.structure}, "
                                            f"stiffness {problem.stiffness.describe()}"))
+    if len(result.solution_set):
+        show(_frame_table(result.solution_set.head(8), f"distinct optima reached ({len(result.solution_set)} among "
+                                                       f"{len(result.solutions)} solves; solution_set.csv)"))
     if result.best is None:
         out.print("[yellow]No start tracks the path within tolerance; see summary.csv for statuses.[/yellow]")
     else:

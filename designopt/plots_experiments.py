@@ -151,3 +151,30 @@ def module_pca_figure(links: np.ndarray, modules: np.ndarray, assignment: list[i
     ax.set_title("Link design vectors and modules (d, a, cos α, sin α)", fontsize=9)
     ax.legend(fontsize=7)
     return save(fig, directory, "module_pca")
+
+
+def search_progress_figure(progress: pd.DataFrame, solution_set: pd.DataFrame, directory: Path) -> list[Path]:
+    """Best tracking cost so far against solves and solver seconds (would more budget help?), and the distinct
+    optima the search reached with how often."""
+    fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(11, 3.4))
+    from matplotlib.ticker import MaxNLocator
+
+    for ax, x, label in ((a1, "solves", "solves finished"), (a2, "solver_seconds", "solver time [s]")):
+        ax.scatter(progress[x], progress["cost"], s=12, color="0.6", label="each tracking solve")
+        ax.step(progress[x], progress["best_cost"], where="post", color="C0", label="best so far")
+        ax.set_xlabel(label)
+        ax.set_ylabel("design cost")
+        ax.set_yscale("log")
+    a1.xaxis.set_major_locator(MaxNLocator(integer=True))
+    a1.legend(fontsize=7)
+    if len(solution_set):
+        a3.bar(solution_set["optimum"].astype(str), solution_set["reached_by"], color="C2")
+        for x, (_, row) in enumerate(solution_set.iterrows()):
+            a3.annotate(f"{row['design_cost']:.2e}", (x, row["reached_by"]), ha="center", va="bottom", fontsize=7,
+                        rotation=90, xytext=(0, 2), textcoords="offset points")
+        a3.set_ylim(0, solution_set["reached_by"].max() * 1.6)
+    a3.yaxis.set_major_locator(MaxNLocator(integer=True))
+    a3.set_xlabel("distinct optimum (best first)")
+    a3.set_ylabel("solves that reached it")
+    fig.tight_layout()
+    return save(fig, directory, "search_progress")

@@ -3,6 +3,7 @@ joints. Computed from solutions or from summary.csv; plots draw them, the CLI pr
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from designopt.design_space import enumerate_structures
@@ -55,3 +56,59 @@ def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
     table = pd.DataFrame(rows)
     order = {s: i for i, s in enumerate(enumerate_structures(1, 12))}
     return table.sort_values("structure", key=lambda c: c.map(order)).reset_index(drop=True)
+
+
+def design_distance(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> float:
+    """Largest difference between two designs: metres for lengths, radians (wrapped to [-pi, pi]) for angles."""
+    d = np.asarray(a, float) - np.asarray(b, float)
+    d = np.where(angle, np.arctan2(np.sin(d), np.cos(d)), d)
+    return float(np.max(np.abs(d))) if d.size else 0.0
+
+
+def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, tol: float = 0.02) -> np.ndarray:
+    """Label each design with its local optimum: in order of cost, a design joins the first (cheaper) cluster
+    whose representative lies within ``tol`` (m or rad) in every design joint, else starts a new one."""
+    order = np.argsort(costs, kind="stable")
+    labels, leaders = np.empty(len(costs), dtype=int), []
+    for i in order:
+        for k, j in enumerate(leaders):
+            if design_distance(designs[i], designs[j], angle) <= tol:
+                labels[i] = k
+                break
+        else:
+            labels[i] = len(leaders)
+            leaders.append(i)
+    return labels
+
+
+def solution_set(solutions: list, tol: float = 0.02) -> pd.DataFrame:
+    """The distinct local optima the tracking solutions reached, best first: cost, how many solves reached each
+    (and which seeds), and the spread of their costs. Designs are compared joint by joint (`cluster_designs`)."""
+    tracking = [s for s in solutions if s.metrics.tracks]
+    if not tracking:
+        return pd.DataFrame(columns=["optimum", "design_cost", "reached_by", "share", "seeds", "worst_cost_in_cluster",
+                                     "ratio_to_best"])
+    angle = np.array([j.kind == "angle" for j in tracking[0].problem.chain.design], dtype=bool)
+    costs = np.array([s.metrics.design_cost for s in tracking])
+    labels = cluster_designs(np.array([s.raw.q_d for s in tracking]), costs, angle, tol)
+    rows = []
+    for k in range(labels.max() + 1):
+        members = np.flatnonzero(labels == k)
+        rows.append({"optimum": k + 1, "design_cost": float(costs[members].min()), "reached_by": len(members),
+                     "share": len(members) / len(solutions),
+                     "seeds": " ".join(str(tracking[i].raw.seed) for i in members),
+                     "worst_cost_in_cluster": float(costs[members].max())})
+    table = pd.DataFrame(rows)
+    table["ratio_to_best"] = table["design_cost"] / table["design_cost"].min()
+    return table
+
+
+def best_so_far(summary: pd.DataFrame) -> pd.DataFrame:
+    """Best tracking design cost after each solve, in the order the solves finished (summary.csv's row order),
+    against the number of solves and the solver seconds spent; ``cost`` is each solve's own (NaN if it does not
+    track)."""
+    tracks = summary["tracks"].astype(str) == "True"
+    cost = summary["design_cost"].where(tracks)
+    return pd.DataFrame({"solves": np.arange(1, len(summary) + 1),
+                         "solver_seconds": summary["solve_time_s"].cumsum().to_numpy(),
+                         "cost": cost.to_numpy(), "best_cost": cost.cummin().ffill().to_numpy()})

@@ -95,3 +95,12 @@ def test_missing_config_exits_2(tmp_path):
     result = runner.invoke(app, ["run", str(tmp_path / "nope.yaml")])
     assert result.exit_code == 2
     assert "no such file" in result.output
+
+
+def test_the_solution_set_is_an_output(finished_run):
+    _, run = finished_run
+    optima = pd.read_csv(run / "solution_set.csv")
+    summary = pd.read_csv(run / "summary.csv")
+    assert optima["reached_by"].sum() == summary["tracks"].sum()
+    assert optima["design_cost"].is_monotonic_increasing and optima["ratio_to_best"].iloc[0] == 1.0
+    assert (run / "figures" / "search_progress.png").stat().st_size > 1000

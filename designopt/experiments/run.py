@@ -13,6 +13,7 @@ from designopt.experiments.tasks import Progress, best_of, multistart_tasks, sol
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
+from designopt.tables import best_so_far, solution_set
 
 
 @dataclass(frozen=True)
@@ -21,6 +22,7 @@ class RunResult:
     solutions: list[Solution]
     best: Solution | None
     summary: pd.DataFrame
+    solution_set: pd.DataFrame  # the distinct local optima reached, best first (tables.solution_set)
 
 
 def run_experiment(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
@@ -37,13 +39,21 @@ def run_experiment(cfg: Config, base_dir: Path, out_root: Path, run_name: str | 
     done = solve_tasks(run, tasks, cfg.name, settings.jobs, resume, progress)
     best_task, best = best_of(done)
     summary = run.mark_best({best_task.file_name} if best is not None else set())
+    solutions = [sol for _, sol in done]
+    optima = solution_set(solutions)
+    optima.to_csv(run.path / "solution_set.csv", index=False)
+    if figures:
+        from designopt import plots_experiments
+
+        plots_experiments.search_progress_figure(best_so_far(summary), optima, run.figures)
     if best is not None:
         write_solution(best, run.path / "best.json")
-        run.log(f"best: seed {best.raw.seed}, design cost {best.metrics.design_cost:.6g}")
+        run.log(f"best: seed {best.raw.seed}, design cost {best.metrics.design_cost:.6g}; {len(optima)} distinct "
+                f"optima among {len(solutions)} solves")
         if figures:
             from designopt import plots
 
             plots.solution_figures(best, run.figures)
     else:
         run.log("no start tracks the path")
-    return RunResult(run, [sol for _, sol in done], best, summary)
+    return RunResult(run, solutions, best, summary, optima)
