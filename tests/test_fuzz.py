@@ -28,7 +28,9 @@ VALUES = st.one_of(
     st.none(), st.booleans(), st.integers(-3, 60), st.sampled_from([0, -1, 10**9, 2**63]),
     st.floats(allow_nan=True, allow_infinity=True), st.floats(-3.0, 3.0),
     st.text(alphabet="RPxyz01.-_ abc", max_size=6), st.sampled_from(["csv", "circle", "line", "figure_eight",
-                                                                   "nowhere.csv", "user_path.csv", "generic"]),
+                                                                   "nowhere.csv", "user_path.csv", "generic",
+                                                                   "robots/ur10.urdf", "tool0", "base_link",
+                                                                   "elbow_joint.origin.z", "user_path.csv"]),
     st.lists(st.floats(-3, 3), max_size=4), st.lists(st.lists(st.floats(-3, 3), max_size=3), max_size=3),
     st.dictionaries(st.sampled_from(["kind", "d", "a", "revolute", "x", "bogus"]), st.floats(-2, 2), max_size=2),
 )
@@ -81,6 +83,7 @@ def _check(config_text: str, csv: str | None = None) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         shutil.copy(ROOT / "configs" / "user_path.csv", tmp / "user_path.csv")
+        shutil.copytree(ROOT / "configs" / "robots", tmp / "robots")  # the URDF robots configs refer to
         if csv is not None:
             (tmp / "fuzz.csv").write_text(csv)
         config = tmp / "fuzz.yaml"
