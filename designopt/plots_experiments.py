@@ -19,6 +19,7 @@ def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Pa
     methods = [m for m in METHOD_LABELS if m in set(table["method"])]
     fig, ax = plt.subplots(figsize=(7, 3.8))
     width = 0.8 / len(methods)
+    top = 0.0
     for j, method in enumerate(methods):
         for i, case in enumerate(cases):
             row = table[(table["case"] == case) & (table["method"] == method)]
@@ -31,13 +32,18 @@ def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Pa
             starts = summary[(summary["case"] == case) & (summary["method"] == method) & summary["tracks"]]
             ax.scatter(np.full(len(starts), x), starts["design_cost"], s=8, color="k", zorder=3,
                        label="every tracking start" if (i == 0 and j == 0) else None)
-            ax.text(x, cost * 0.55, f"{row['max_joint_step'].iloc[0]:.2g} rad", ha="center", va="top",
-                    fontsize=6, rotation=90, color="white")
+            # above the bar and its dots, so that a short bar never cuts its label
+            high = max([cost, *starts["design_cost"]])
+            top = max(top, high)
+            ax.annotate(f"{row['max_joint_step'].iloc[0]:.2g} rad", (x, high), xytext=(0, 4),
+                        textcoords="offset points", ha="center", va="bottom", fontsize=6, rotation=90)
     n_design = table.drop_duplicates("case").set_index("case")["n_design_joints"]
     ax.set_xticks(range(len(cases)), [f"{CASE_LABELS[c]}\n({n_design[c]} design joints)" for c in cases])
     ax.set_yscale("log")
+    if top > 0:
+        ax.set_ylim(top=top * 30)  # room for the labels above the highest dot
     ax.set_ylabel("design cost  Σ Δt L_d  (best tracking start)")
-    ax.set_title("Continuous design problem: label in bar = largest joint step between waypoints")
+    ax.set_title("Continuous design problem: label = largest joint step between waypoints")
     ax.legend(fontsize=7)
     return save(fig, directory, "design_cost")
 
