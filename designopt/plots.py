@@ -46,12 +46,26 @@ def draw_robot(ax, chain, q: np.ndarray, points_W: np.ndarray | None = None, col
     if points_W is not None:
         T_BW = placement_pose(chain, q, np.zeros(0))
         s_B = (T_BW[:3, :3] @ np.asarray(points_W).T).T + T_BW[:3, 3]
+        drawn.append(draw_workpiece(ax, T_BW, np.asarray(points_W), show_label=label is None))
         ax.plot(*s_B.T, "-", color="C3", lw=1.5, label="toolpath (placed)" if label is None else None)
         for axis, c in zip(range(3), ("r", "g", "b"), strict=True):
             end = T_BW[:3, 3] + 0.1 * T_BW[:3, axis]
             ax.plot(*np.c_[T_BW[:3, 3], end], color=c, lw=1)
         drawn.append(s_B)
     return np.vstack(drawn)
+
+
+def draw_workpiece(ax, T_BW: np.ndarray, points_W: np.ndarray, margin: float = 0.05, show_label: bool = True):
+    """The workpiece's top face: a plate in W's z = 0 plane around the path (margin in m), placed by T_BW.
+    Returns its corners in B."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    lo, hi = points_W[:, :2].min(axis=0) - margin, points_W[:, :2].max(axis=0) + margin
+    corners_W = np.array([[lo[0], lo[1], 0], [hi[0], lo[1], 0], [hi[0], hi[1], 0], [lo[0], hi[1], 0]])
+    corners_B = corners_W @ T_BW[:3, :3].T + T_BW[:3, 3]
+    ax.add_collection3d(Poly3DCollection([corners_B], facecolor="0.6", edgecolor="0.4", alpha=0.25,
+                                         label="workpiece top face" if show_label else None))
+    return corners_B
 
 
 def _label_axes(ax) -> None:
