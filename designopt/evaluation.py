@@ -11,10 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from designopt import costs
-from designopt.costs import deformation_term
+from designopt.costs import deformation_term, tracking_residual
 from designopt.problem import DesignProblem
-
-Z_DOWN = np.array([0.0, 0.0, -1.0])  # the target tool axis in W: into the surface
 
 
 @dataclass(frozen=True)
@@ -66,8 +64,9 @@ def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> Metrics:
     q_d = np.asarray(q_d, dtype=float)
     states = [problem.waypoint(Q[k], q_d, tp.points_W[k], tp.force_W[k]) for k in range(tp.n)]
     deform = np.array([deformation_term(w) for w in states])
-    pos_err = np.array([np.linalg.norm(w.p_W - w.s_W) for w in states])
-    axis_err = np.array([np.linalg.norm(w.z_W - Z_DOWN) for w in states])
+    residuals = [tracking_residual(w) for w in states]
+    pos_err = np.array([np.linalg.norm(r_p) for r_p, _ in residuals])
+    axis_err = np.array([np.linalg.norm(r_z) for _, r_z in residuals])
     s_B = [w.T_BW[:3, :3] @ w.s_W + w.T_BW[:3, 3] for w in states]
     values = {c.name: tp.dt * float(sum(c.fn(w) for w in states)) for c in problem.waypoint_costs}
     values |= {c.name: float(c.fn(chain, q_d)) for c in problem.design_costs}

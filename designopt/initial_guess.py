@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from designopt.costs import tracking_residual
 from designopt.kinematics.chain import geometric_jacobian, placement_pose, tool_pose
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
@@ -136,8 +137,7 @@ def _residual_function(problem: DesignProblem):
 
     chain = problem.chain
     q, q_d, s_W = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design), ca.SX.sym("s_W", 3)
-    w = problem.waypoint(q, q_d, s_W, ca.SX.zeros(3))
-    r = ca.vertcat(w.p_W - s_W, w.z_W - ca.DM([0.0, 0.0, -1.0]))
+    r = ca.vertcat(*tracking_residual(problem.waypoint(q, q_d, s_W, ca.SX.zeros(3))))
     return ca.Function("reach", [q, q_d, s_W], [r, ca.jacobian(r, q), ca.jacobian(r, q_d)])
 
 

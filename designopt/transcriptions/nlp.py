@@ -13,11 +13,11 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import RawResult, ipopt_options, waypoint_function
 from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
 
-Z_DOWN = np.array([0.0, 0.0, -1.0])
 PRE_ITERATION_STATUSES = {"Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition", "Invalid_Option"}
 
 
@@ -116,15 +116,15 @@ def tracking(w, s_W, activation: str, weight_h: float, position: bool = True, ep
     ``position`` False leaves the position out (differential kinematics tracks it as a state).
     Returns (objective part, constraints, lower bounds, upper bounds).
     """
-    r_p, z_W = w.p_W - s_W, w.z_W
+    r_p, r_z = tracking_residual(w)
     if activation == "epsilon":
-        return 0, [ca.sumsqr(r_p) + ca.sumsqr(z_W - ca.DM(Z_DOWN))], [-np.inf], [epsilon]
+        return 0, [ca.sumsqr(r_p) + ca.sumsqr(r_z)], [-np.inf], [epsilon]
     if activation == "soft":
-        return weight_h * (ca.sumsqr(z_W - ca.DM(Z_DOWN)) + (ca.sumsqr(r_p) if position else 0)), [], [], []
+        return weight_h * (ca.sumsqr(r_z) + (ca.sumsqr(r_p) if position else 0)), [], [], []
     if activation != "hard":
         raise ValueError(f"tracking must be one of {TRACKING_ACTIVATIONS}, got {activation!r}")
     c, lo, hi = ([r_p], [0.0] * 3, [0.0] * 3) if position else ([], [], [])
-    return 0, [*c, z_W], [*lo, 0.0, 0.0, -np.inf], [*hi, 0.0, 0.0, 0.0]
+    return 0, [*c, w.z_W], [*lo, 0.0, 0.0, -np.inf], [*hi, 0.0, 0.0, 0.0]
 
 
 def waypoint_terms(problem: DesignProblem, activation: str, position_in_terms: bool = True, epsilon: float = 0.0):
