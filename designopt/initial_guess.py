@@ -57,27 +57,6 @@ def ik_residual(problem: DesignProblem, q: np.ndarray, q_d: np.ndarray, k: int):
     return r, np.vstack([R_WB @ J[:3, :], R_WB @ Jz])
 
 
-def _ik_point(problem: DesignProblem, q_d: np.ndarray, q: np.ndarray, k: int, iterations: int, lo=None,
-              hi=None) -> np.ndarray:
-    """Damped least-squares IK at waypoint k from q."""
-    if lo is None:
-        lo = np.array([j.lower for j in problem.chain.moving])
-        hi = np.array([j.upper for j in problem.chain.moving])
-    damping = 1e-2
-    r, J = ik_residual(problem, q, q_d, k)
-    for _ in range(iterations):
-        step = np.linalg.solve(J.T @ J + damping * np.eye(len(q)), -J.T @ r)
-        trial = np.clip(q + step, lo, hi)
-        r_new, J_new = ik_residual(problem, trial, q_d, k)
-        if r_new @ r_new < r @ r:
-            q, r, J, damping = trial, r_new, J_new, max(damping / 3, 1e-6)
-        else:
-            damping *= 5
-        if r @ r < 1e-14:
-            break
-    return q
-
-
 def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, iterations: int = 30) -> np.ndarray:
     """Damped least-squares IK along the path, each waypoint starting from the previous solution."""
     lo = np.array([j.lower for j in problem.chain.moving])
@@ -85,7 +64,18 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     Q = np.empty((problem.toolpath.n, len(q0)))
     q = np.array(q0, dtype=float)
     for k in range(problem.toolpath.n):
-        q = _ik_point(problem, q_d, q, k, iterations if k == 0 else max(8, iterations // 3), lo, hi)
+        damping = 1e-2
+        r, J = ik_residual(problem, q, q_d, k)
+        for _ in range(iterations if k == 0 else max(8, iterations // 3)):
+            step = np.linalg.solve(J.T @ J + damping * np.eye(len(q)), -J.T @ r)
+            trial = np.clip(q + step, lo, hi)
+            r_new, J_new = ik_residual(problem, trial, q_d, k)
+            if r_new @ r_new < r @ r:
+                q, r, J, damping = trial, r_new, J_new, max(damping / 3, 1e-6)
+            else:
+                damping *= 5
+            if r @ r < 1e-14:
+                break
         Q[k] = q
     return Q
 

@@ -70,13 +70,13 @@ class RunDirectory:
         unknown = sorted(set(row) - set(SUMMARY_COLUMNS) - {k for k in row if k.startswith("cost_")})
         if unknown:
             raise ValueError(f"summary.csv has no column for {unknown}")
-        fieldnames, rows = self._read_rows()
+        fieldnames = self._header()  # one line: appending stays cheap however long the file is
         new = not fieldnames
         if new:
             fieldnames = _columns(row)
         elif set(row) - set(fieldnames):
             fieldnames = _columns({**dict.fromkeys(fieldnames), **row})
-            self._rewrite(fieldnames, rows)
+            self._rewrite(fieldnames, self._read_rows()[1])
         buffer = io.StringIO()
         writer = csv.DictWriter(buffer, fieldnames=fieldnames, lineterminator="\n")
         if new:
@@ -98,6 +98,12 @@ class RunDirectory:
         summary.to_csv(tmp, index=False)
         os.replace(tmp, self.summary)
         return summary
+
+    def _header(self) -> list[str]:
+        if not self.summary.exists() or self.summary.stat().st_size == 0:
+            return []
+        with self.summary.open(newline="") as fh:
+            return next(csv.reader(fh), [])
 
     def _read_rows(self) -> tuple[list[str], list[dict]]:
         if not self.summary.exists() or self.summary.stat().st_size == 0:
