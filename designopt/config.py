@@ -93,12 +93,24 @@ class RobotConfig(_Strict):
     tool_link: str | None = None
     design_origins: list[str] = []  # URDF origin components that are design joints, e.g. elbow_joint.origin.z
     bounds: BoundsConfig = BoundsConfig()
-    stiffness: Positive | StiffnessConfig = 1.0
+    # one value (both types), {revolute, prismatic}, one value per moving joint, or a preset name
+    stiffness: Positive | StiffnessConfig | list[Positive] | str = 1.0
     joint_velocity: Positive = 10.0
 
     @property
     def is_urdf(self) -> bool:
         return self.urdf is not None
+
+    @field_validator("stiffness")
+    @classmethod
+    def _known_stiffness_preset(cls, v):
+        from designopt.costs import STIFFNESS_PRESETS
+
+        if isinstance(v, str) and v not in STIFFNESS_PRESETS:
+            raise ValueError(f"unknown stiffness preset '{v}' (known: {', '.join(sorted(STIFFNESS_PRESETS))})")
+        if isinstance(v, list) and not v:
+            raise ValueError("an empty list: give one stiffness per moving joint")
+        return v
 
     @field_validator("dh")
     @classmethod

@@ -68,12 +68,15 @@ def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> Metrics:
     pos_err = np.array([np.linalg.norm(r_p) for r_p, _ in residuals])
     axis_err = np.array([np.linalg.norm(r_z) for _, r_z in residuals])
     s_B = [w.T_BW[:3, :3] @ w.s_W + w.T_BW[:3, 3] for w in states]
-    values = {c.name: tp.dt * float(sum(c.fn(w) for w in states)) for c in problem.waypoint_costs}
+    weights, tracked = tp.weights, tp.is_tracked
+    values = {c.name: float(sum(wk * c.fn(w) for wk, w in zip(weights, states, strict=True)))
+              for c in problem.waypoint_costs}
     values |= {c.name: float(c.fn(chain, q_d)) for c in problem.design_costs}
     regularization = sum(c.weight * values[c.name] for c in problem.design_costs if c.name == "regularization")
-    max_pos, max_axis = float(pos_err.max()), float(axis_err.max())
+    # rapids (untracked waypoints) may leave the path: errors count where the tool cuts
+    max_pos, max_axis = float(pos_err[tracked].max()), float(axis_err[tracked].max())
     return Metrics(
-        design_cost=costs.design_cost(deform, tp.dt),
+        design_cost=costs.design_cost(deform, weights),
         regularization=float(regularization),
         max_position_error=max_pos,
         max_axis_error=max_axis,

@@ -155,7 +155,10 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
 
 def tracks(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> bool:
     """Whether joint values Q with design q_d follow the path within the problem's tolerances."""
+    tracked = problem.toolpath.is_tracked
     for k, q in enumerate(Q):
+        if not tracked[k]:
+            continue
         r = ik_residual(problem, q, q_d, k)[0]
         if np.linalg.norm(r[:3]) > problem.position_tol or np.linalg.norm(r[3:]) > problem.axis_tol:
             return False

@@ -13,6 +13,7 @@ import numpy as np
 from designopt import toolpaths
 from designopt.config import Config, dh_rows
 from designopt.costs import (
+    STIFFNESS_PRESETS,
     DesignCost,
     Stiffness,
     Waypoint,
@@ -142,10 +143,18 @@ def check_standoff(cfg: Config, chain: Chain, toolpath: toolpaths.Toolpath) -> N
                                                      f"{farthest:.4g} m from the base axis inside placement.box")
 
 
-def stiffness_from_config(cfg: Config) -> Stiffness:
+def stiffness_from_config(cfg: Config, n_moving: int) -> Stiffness:
+    """The config's stiffness model; a per-joint list (or preset) must give one value per moving joint."""
     k = cfg.robot.stiffness
     if isinstance(k, float | int):
         return Stiffness(float(k), float(k))
+    if isinstance(k, str | list):
+        values = STIFFNESS_PRESETS[k] if isinstance(k, str) else tuple(float(v) for v in k)
+        if len(values) != n_moving:
+            what = f"preset {k} has" if isinstance(k, str) else "the list has"
+            raise cfg.error("robot.stiffness", f"{what} {len(values)} values but the robot has {n_moving} moving "
+                                               "joints (one per joint, base to tool)")
+        return Stiffness(per_joint=values, name=k if isinstance(k, str) else "")
     return Stiffness(k.revolute, k.prismatic)
 
 
@@ -179,7 +188,7 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         name=cfg.name,
         chain=chain,
         toolpath=toolpath,
-        stiffness=stiffness_from_config(cfg),
+        stiffness=stiffness_from_config(cfg, chain.n_moving),
         deflection=cfg.costs.deflection,
         # deformation_weight only rescales the objective (a unit choice for physical stiffness models, whose
         # L_d is ~1e-8 m^2 and would otherwise be drowned by the regularisation); the reported cost is unscaled.

@@ -64,14 +64,16 @@ class Solution:
         norms = np.linalg.norm(force, axis=1, keepdims=True)
         points = np.array(tp["points_W"], dtype=float)
         t = np.array(tp.get("t", np.linspace(0, 1, len(points))), dtype=float)
+        tracked = np.array(tp["tracked"], dtype=bool) if "tracked" in tp else None
         toolpath = Toolpath(tp.get("kind", "file"), t, points, np.divide(force, norms, where=norms > 0,
-                                                                       out=np.zeros_like(force)), force)
-        k = dict(zip(chain.structure, data["stiffness"], strict=True))  # the two-value model: one per joint type
+                                                                       out=np.zeros_like(force)), force, tracked,
+                            tp.get("time_unit", "task"), tp.get("force_model", "paper"))
         m = data["metrics"]
         tol = m.get("tolerances", {})
         limits = data.get("joint_limits") or [{}]
         problem = DesignProblem(name=data.get("method", "file"), chain=chain, toolpath=toolpath,
-                                stiffness=Stiffness(k.get("R", 1.0), k.get("P", 1.0)), deflection=m["deflection"],
+                                stiffness=Stiffness(per_joint=tuple(float(v) for v in data["stiffness"])),
+                                deflection=m["deflection"],
                                 position_tol=tol.get("position", 1e-3), axis_tol=tol.get("axis", 1e-2),
                                 joint_velocity=float(limits[0].get("velocity_per_task_time", 10.0)))
         raw = _raw_from_file(data, np.zeros(0))
@@ -116,8 +118,8 @@ class Solution:
             "objective": r.objective,
             "kinematic_drift": r.kinematic_drift,
             "seed": r.seed,
-            "stiffness_revolute": self.problem.stiffness.revolute,
-            "stiffness_prismatic": self.problem.stiffness.prismatic,
+            "stiffness_revolute": self.problem.stiffness.by_type()[0],
+            "stiffness_prismatic": self.problem.stiffness.by_type()[1],
             "deflection": self.problem.deflection,
         }
 
@@ -166,6 +168,9 @@ def to_dict(sol: Solution) -> dict:
             "t": p.toolpath.t.tolist(),
             "points_W": p.toolpath.points_W.tolist(),
             "force_W": p.toolpath.force_W.tolist(),
+            "time_unit": p.toolpath.time_unit,
+            "force_model": p.toolpath.force_model,
+            **({"tracked": p.toolpath.is_tracked.tolist()} if p.toolpath.tracked is not None else {}),
         },
         "q": np.asarray(r.Q).tolist(),
         # joint velocities dq/dt at the waypoints (TO's Hermite knots; absent for FK): with q they define
@@ -196,8 +201,9 @@ def to_dict(sol: Solution) -> dict:
             "n_constraints": r.n_constraints,
             "seed": r.seed,
             "tolerances": {"position": p.position_tol, "axis": p.axis_tol},
-            "stiffness_model": {"revolute_Nm_per_rad": p.stiffness.revolute,
-                                "prismatic_N_per_m": p.stiffness.prismatic},
+            "stiffness_model": {"revolute_Nm_per_rad": _finite(p.stiffness.by_type()[0]),
+                                "prismatic_N_per_m": _finite(p.stiffness.by_type()[1]),
+                                "described": p.stiffness.describe()},
         },
     }
 

@@ -1,7 +1,9 @@
-"""Toolpaths s(t) in the workpiece frame W, sampled at N waypoints t_k = k / (N - 1).
+"""Toolpaths s(t) in the workpiece frame W, sampled at N waypoints t_k.
 
-Units: metres; t is normalised task time in [0, 1]. The process force of SPEC §3 points along the unit
-tangent: F = alpha * s'(t) / |s'(t)|.
+Units: metres. For the paper's paths (figure-eight, circle, line, CSV) t is normalised task time,
+t_k = k / (N - 1), and the process force of SPEC §3 points along the unit tangent: F = alpha * s'(t) / |s'(t)|.
+A G-code program (`designopt.gcode`) gives t in seconds from its feeds, a force per waypoint from a cutting
+model (`designopt.forces`), and waypoints that are not tracked (the rapids between cuts).
 """
 
 from __future__ import annotations
@@ -23,22 +25,55 @@ class ToolpathError(ValueError):
 
 @dataclass(frozen=True)
 class Toolpath:
-    """Waypoints of a path in W with their unit tangents and process forces (N x 3 arrays)."""
+    """Waypoints of a path in W with their unit tangents and process forces (N x 3 arrays).
+
+    ``tracked`` (N booleans, default all): where the tool must follow the path. An untracked waypoint (a
+    rapid) carries no force and no tracking constraint; joint limits still hold there. ``time_unit`` is
+    ``task`` (normalised, t in [0, 1]) or ``s`` (seconds, from a program's feeds).
+    """
 
     kind: str
     t: np.ndarray
     points_W: np.ndarray
     tangents_W: np.ndarray
     force_W: np.ndarray
+    tracked: np.ndarray | None = None
+    time_unit: str = "task"
+    force_model: str = "paper"  # "paper": alpha * tangent (SPEC §3); "milling": designopt.forces
 
     @property
     def n(self) -> int:
         return len(self.t)
 
     @property
+    def h(self) -> np.ndarray:
+        """Time steps t_{k+1} - t_k (N - 1)."""
+        return np.diff(self.t)
+
+    @property
+    def uniform(self) -> bool:
+        h = self.h
+        return bool(np.allclose(h, h[0], rtol=1e-9, atol=0.0))
+
+    @property
     def dt(self) -> float:
-        """Task-time step between waypoints, 1 / (N - 1)."""
-        return 1.0 / (self.n - 1)
+        """The one time step of a uniformly sampled path (1 / (N - 1) for task time)."""
+        if not self.uniform:
+            raise ValueError("this toolpath's time steps differ; use Toolpath.h or Toolpath.weights")
+        return float(self.t[-1] - self.t[0]) / (self.n - 1)
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Quadrature weight of each waypoint for integrals sum_k w_k f(t_k): w_k = t_{k+1} - t_k, the last
+        waypoint repeating the last step. On a uniform path every weight is dt, which is the paper's dt * sum."""
+        if self.uniform:
+            return np.full(self.n, self.dt)
+        h = self.h
+        return np.concatenate([h, h[-1:]])
+
+    @property
+    def is_tracked(self) -> np.ndarray:
+        return np.ones(self.n, dtype=bool) if self.tracked is None else np.asarray(self.tracked, dtype=bool)
 
 
 def _from_samples(kind: str, t: np.ndarray, points: np.ndarray, velocity: np.ndarray, force: float) -> Toolpath:

@@ -117,6 +117,13 @@ def _check_rest(data: dict, n: int, file) -> None:
     if len(points) < 2:
         raise SolutionFileError(file, "toolpath.points_W", "a path needs at least 2 waypoints")
     _array(data, "toolpath.force_W", (len(points), 3), file)
+    if "t" in data["toolpath"] and np.any(np.diff(_array(data, "toolpath.t", (len(points),), file)) <= 0):
+        raise SolutionFileError(file, "toolpath.t", "times must increase")
+    tracked = data["toolpath"].get("tracked")
+    if tracked is not None and (not isinstance(tracked, list) or len(tracked) != len(points)
+                                or not all(isinstance(v, bool) for v in tracked) or not any(tracked)):
+        raise SolutionFileError(file, "toolpath.tracked", f"expected {len(points)} true/false values, at least one "
+                                                          "true")
     _array(data, "q", (len(points), n), file)
     metrics = data.get("metrics")
     if not isinstance(metrics, dict):
@@ -225,7 +232,12 @@ def recompute(data: dict, position_tol: float = 1e-3, axis_tol: float = 1e-2, de
     tool = np.array(data["tool"])
     k_inv = 1.0 / np.array(data["stiffness"])
     pts, forces, Q = np.array(data["toolpath"]["points_W"]), np.array(data["toolpath"]["force_W"]), np.array(data["q"])
-    dt = 1.0 / (len(pts) - 1)
+    t = np.array(data["toolpath"].get("t", np.linspace(0.0, 1.0, len(pts))), dtype=float)
+    h = np.diff(t)
+    # quadrature weights: the interval that starts at each waypoint, the last one repeated (dt on a uniform path)
+    weights = np.full(len(pts), (t[-1] - t[0]) / (len(pts) - 1)) if np.allclose(h, h[0], rtol=1e-9, atol=0) \
+        else np.r_[h, h[-1]]
+    tracked = np.array(data["toolpath"].get("tracked", [True] * len(pts)), dtype=bool)
     cost, pos_err, axis_err = 0.0, 0.0, 0.0
     for k in range(len(pts)):
         T, origins, axes, kinds = _robot_walk(data, Q[k])
@@ -238,7 +250,9 @@ def recompute(data: dict, position_tol: float = 1e-3, axis_tol: float = 1e-2, de
         delta = J @ np.diag(k_inv) @ J.T @ w
         if deflection == "translational":
             delta = delta[:3]
-        cost += dt * float(delta @ delta)
+        cost += weights[k] * float(delta @ delta)
+        if not tracked[k]:
+            continue  # a rapid: the tool may leave the path
         s_B = T_BW[:3, :3] @ pts[k] + T_BW[:3, 3]
         pos_err = max(pos_err, float(np.linalg.norm(p - s_B)))
         axis_err = max(axis_err, float(np.linalg.norm(T[:3, 2] - T_BW[:3, :3] @ np.array([0, 0, -1.0]))))
@@ -251,7 +265,9 @@ def problems(data: dict, rtol: float = 1e-6) -> list[tuple[str, str]]:
     m = data["metrics"]
     alpha = float(data["force_alpha"])
     norms = np.linalg.norm(np.array(data["toolpath"]["force_W"], dtype=float), axis=1)
-    if not np.allclose(norms, alpha, rtol=1e-9, atol=1e-12):
+    # the paper's force has one magnitude alpha everywhere; a cutting model's varies (and is 0 on rapids)
+    if data["toolpath"].get("force_model", "paper") == "paper" and not np.allclose(norms, alpha, rtol=1e-9,
+                                                                                    atol=1e-12):
         found.append(("toolpath.force_W", f"force magnitudes {norms.min():.6g}..{norms.max():.6g} differ from "
                                           f"force_alpha {alpha:.6g}"))
     check = recompute(data)

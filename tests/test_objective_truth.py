@@ -234,7 +234,7 @@ def test_optimizer_and_evaluation_agree_with_reference_at_random_points(deflecti
         placement = [values[f"placement.{p}"] for p in ("x", "y", "z", "yaw", "pitch", "roll")]
         p_ref, z_ref, L_ref = ref_waypoint(structure, dh, placement, q, s_W, f_W, [3.0, 0.2, 3, 3, 0.2, 3],
                                            deflection)
-        phi, c = terms(np.r_[q, q_d], s_W, f_W)
+        phi, c = terms(np.r_[q, q_d], s_W, f_W, [h, 1.0])
         c = np.array(c).ravel()
         np.testing.assert_allclose(c[:3], p_ref - s_W, atol=1e-12)
         np.testing.assert_allclose(c[3:6], z_ref, atol=1e-12)

@@ -27,9 +27,12 @@ from designopt.transcriptions.nlp import (
     BlockStructure,
     ConstraintList,
     WaypointNLP,
+    free_untracked,
     joint_regularization,
     once_only_rows,
     quadratic_design_costs,
+    tracking_rows,
+    waypoint_inputs,
     waypoint_terms,
     y_indices,
 )
@@ -91,7 +94,9 @@ class CollocationNLP:
         t0 = time.perf_counter()
         self.problem, self.scheme = problem, scheme
         chain, tp = problem.chain, problem.toolpath
-        n_m, n_d, N, h = chain.n_moving, chain.n_design, tp.n, tp.dt
+        n_m, n_d, N = chain.n_moving, chain.n_design, tp.n
+        # one step for a uniform path keeps its expressions (and results) as they were; else one per interval
+        h = tp.dt if tp.uniform else ca.DM(np.tile(tp.h, (n_m, 1)))
         differential = scheme.kinematics == "differential"
         self.n_state = 2 * n_m + (3 if differential else 0)
 
@@ -99,10 +104,10 @@ class CollocationNLP:
         Z = ca.SX.sym("Z", self.n_state, N)  # column k: (q_k, v_k[, p_k])
         x = ca.vertcat(q_d, ca.vec(Z))
         Q, V = Z[:n_m, :], Z[n_m : 2 * n_m, :]
-        S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
+        S, F, K_w = waypoint_inputs(tp)
 
         terms, c_lo, c_hi = waypoint_terms(problem, scheme.tracking, position_in_terms=not differential)
-        Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F)
+        Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F, K_w)
 
         Q0, V0, Q1, V1 = Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:]
         Q_mid, V_mid = hermite_midpoint(Q0, V0, Q1, V1, h)
@@ -110,7 +115,7 @@ class CollocationNLP:
         # The smoothness term must stay small against the design cost: the figure-eight needs joint
         # accelerations of ~100 rad per unit task time squared, so 1e-6 already outweighed L_d (measured).
         accel = ca.sum1(ca.sum2(hermite_acceleration_integral(Q0, V0, Q1, V1, h)))
-        quadratic += problem.smoothness * accel + joint_regularization(problem, Q, h)
+        quadratic += problem.smoothness * accel + joint_regularization(problem, Q, tp.dt if tp.uniform else tp.weights)
         objective = ca.sum2(Phi) + quadratic
 
         cons = ConstraintList()
@@ -118,20 +123,26 @@ class CollocationNLP:
         C_lo, C_hi = np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N))
         once = once_only_rows(problem, scheme.tracking) if not differential else np.zeros(0, dtype=int)
         C_lo[once, 1:], C_hi[once, 1:] = -np.inf, np.inf
+        C_lo, C_hi = free_untracked(problem, C_lo, C_hi,
+                                    tracking_rows(problem, scheme.tracking, position_in_terms=not differential))
         cons.add(C, C_lo, C_hi)  # first, so that its multipliers are 0 .. n_c N
 
         if differential:
             P = Z[2 * n_m :, :]
             wp = waypoint_function(problem)
             p_W, _, _, Jv = wp.map(N)(Q, ca.repmat(q_d, 1, N), S, F)
+            h3 = tp.dt if tp.uniform else ca.DM(np.tile(tp.h, (3, 1)))
             _, _, _, Jv_mid = wp.map(N - 1)(Q_mid, ca.repmat(q_d, 1, N - 1), S[:, :-1], F[:, :-1])
             pdot, pdot_mid = _pdot(Jv, V, n_m, N), _pdot(Jv_mid, V_mid, n_m, N - 1)
             cons.add(P[:, 0] - p_W[:, 0], 0.0, 0.0)
-            cons.add(P[:, 1:] - P[:, :-1] - h / 6.0 * (pdot[:, :-1] + 4 * pdot_mid + pdot[:, 1:]), 0.0, 0.0)
+            cons.add(P[:, 1:] - P[:, :-1] - h3 / 6.0 * (pdot[:, :-1] + 4 * pdot_mid + pdot[:, 1:]), 0.0, 0.0)
+            tracked = tp.is_tracked
             if scheme.tracking == "hard":
-                cons.add(P - S, 0.0, 0.0)
+                bound = np.where(tracked, 0.0, np.inf)[None, :].repeat(3, axis=0)
+                cons.add(P - S, -bound, bound)
             else:
-                objective += h * problem.tracking_weight * ca.sumsqr(P - S)
+                weight = ca.DM((tp.weights * tracked)[None, :])
+                objective += problem.tracking_weight * ca.sum2(weight * ca.sum1((P - S) ** 2))
             self._drift = ca.Function("drift", [x], [ca.mmax(ca.sqrt(ca.sum1((P - p_W) ** 2)))])
 
         lo_m = np.array([j.lower for j in chain.moving])

@@ -25,8 +25,11 @@ from designopt.transcriptions.nlp import (
     BlockStructure,
     ConstraintList,
     WaypointNLP,
+    free_untracked,
     joint_regularization,
     quadratic_design_costs,
+    tracking_rows,
+    waypoint_inputs,
     waypoint_terms,
     y_indices,
 )
@@ -63,7 +66,7 @@ class ForwardKinematicsNLP:
         t0 = time.perf_counter()
         self.problem, self.scheme = problem, scheme
         chain, tp = problem.chain, problem.toolpath
-        n_m, n_d, N, h = chain.n_moving, chain.n_design, tp.n, tp.dt
+        n_m, n_d, N = chain.n_moving, chain.n_design, tp.n
         # (0.95 tol)^2: IPOPT accepts constraint violations of ~1e-8, which on L_t <= tol^2 alone would put
         # the position error just above tol (measured 1.0045 mm for tol = 1 mm).
         self.epsilon = scheme.epsilon if scheme.epsilon is not None else (0.95 * problem.position_tol) ** 2
@@ -71,17 +74,18 @@ class ForwardKinematicsNLP:
         q_d = ca.SX.sym("q_d", n_d)
         Q = ca.SX.sym("Q", n_m, N)
         x = ca.vertcat(q_d, ca.vec(Q))
-        S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
         terms, c_lo, c_hi = waypoint_terms(problem, "epsilon", epsilon=self.epsilon)
-        Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F)
-        quadratic = joint_regularization(problem, Q, h) + quadratic_design_costs(problem, q_d)
+        Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), *waypoint_inputs(tp))
+        quadratic = joint_regularization(problem, Q, tp.dt if tp.uniform else tp.weights) \
+            + quadratic_design_costs(problem, q_d)
         objective = ca.sum2(Phi) + quadratic
 
         cons = ConstraintList()
         n_c = C.shape[0]
-        cons.add(C, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)))
+        cons.add(C, *free_untracked(problem, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)),
+                                    tracking_rows(problem, "epsilon")))
         if scheme.continuous:
-            step = problem.joint_velocity * h
+            step = problem.joint_velocity * np.tile(tp.h, (n_m, 1))
             cons.add(Q[:, 1:] - Q[:, :-1], -step, step)
 
         lo_m = [j.lower for j in chain.moving]

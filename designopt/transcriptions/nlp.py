@@ -64,9 +64,8 @@ class WaypointNLP:
             constant = np.array(ca.evalf(ca.hessian(quadratic, x)[0])) if not isinstance(quadratic, (int, float)) \
                 else np.zeros((x.shape[0], x.shape[0]))
             block = block_hessian_function(blocks.terms, n_y, n_c, blocks.compile)
-            S, F = ca.DM(tp.points_W.T), ca.DM(tp.force_W.T)
             opts["hess_lag"] = assemble_hessian(self.n_variables, self.n_constraints, block, blocks.y_index,
-                                                [S, F], blocks.mu_index, constant)
+                                                list(waypoint_inputs(tp)), blocks.mu_index, constant)
         self.solver = ca.nlpsol(name, "ipopt", {"x": x, "f": objective, "g": g}, opts)
         self.build_time_s = time.perf_counter() - t_start
 
@@ -98,11 +97,30 @@ def y_indices(n_d: int, n_m: int, N: int, stride: int) -> np.ndarray:
     return np.hstack([q_index, np.tile(np.arange(n_d), (N, 1))])
 
 
-def joint_regularization(problem: DesignProblem, Q, h: float):
-    """h * weight * sum |q_k|^2: removes exact null directions (a constant joint offset against the
+def waypoint_inputs(toolpath):
+    """The per-waypoint constants of the terms function, one column per waypoint: s_W (3 x N), f_W (3 x N)
+    and (w_k, tracked_k) (2 x N): quadrature weight and whether the tool must follow the path there."""
+    k_w = np.vstack([toolpath.weights, toolpath.is_tracked.astype(float)])
+    return ca.DM(toolpath.points_W.T), ca.DM(toolpath.force_W.T), ca.DM(k_w)
+
+
+def free_untracked(problem: DesignProblem, lo: np.ndarray, hi: np.ndarray, rows: np.ndarray):
+    """Bounds (n_c x N) of the per-waypoint constraints with the tracking ``rows`` freed at untracked
+    waypoints (rapids): the rows stay in the NLP, so its shape and Hessian pattern do not depend on the path."""
+    lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
+    free = ~problem.toolpath.is_tracked
+    lo[np.ix_(rows, free)], hi[np.ix_(rows, free)] = -np.inf, np.inf
+    return lo, hi
+
+
+def joint_regularization(problem: DesignProblem, Q, h):
+    """sum_k w_k * weight * |q_k|^2: removes exact null directions (a constant joint offset against the
     placement yaw; rotation about the tool axis) that otherwise stall IPOPT. Weight: costs.joint_regularization,
-    small enough to stay well below 1 % of the design cost on the default problem."""
-    return problem.joint_regularization * h * ca.sumsqr(Q)
+    small enough to stay well below 1 % of the design cost on the default problem. ``h``: the time step of a
+    uniform path, or the N quadrature weights."""
+    if np.ndim(h) == 0:
+        return problem.joint_regularization * h * ca.sumsqr(Q)
+    return problem.joint_regularization * ca.sum2(ca.DM(np.asarray(h)[None, :]) * ca.sum1(Q * Q))
 
 
 TRACKING_ACTIVATIONS = ("hard", "soft", "epsilon")
@@ -130,15 +148,18 @@ def tracking(w, s_W, activation: str, weight_h: float, position: bool = True, ep
 def waypoint_terms(problem: DesignProblem, activation: str, position_in_terms: bool = True, epsilon: float = 0.0):
     """Cost phi_k and constraints c_k at one waypoint as a function of y_k = (q_k, q_d).
 
-    phi_k holds every `WaypointCost` (dt * weight * fn), every non-quadratic `DesignCost` spread evenly over the
-    waypoints (so that the per-waypoint blocks, and with them the exact structured Hessian, carry it) and,
-    when soft, the tracking penalty. Returns the CasADi function (y, s_W, f_W) -> (phi, c) and the bounds of
-    c. The position enters only when p = FK(q); in differential mode it is a state.
+    phi_k holds every `WaypointCost` (w_k * weight * fn), every non-quadratic `DesignCost` spread evenly over
+    the waypoints (so that the per-waypoint blocks, and with them the exact structured Hessian, carry it) and,
+    when soft, the tracking penalty (zero where the waypoint is not tracked). Returns the CasADi function
+    (y, s_W, f_W, k_w) -> (phi, c), with k_w = (w_k, tracked_k) (see `waypoint_inputs`), and the bounds of c.
+    Its first `tracking_rows` rows are the tracking constraints. The position enters only when p = FK(q); in
+    differential mode it is a state.
     """
     chain, tp = problem.chain, problem.toolpath
-    n_m, n_d, h = chain.n_moving, chain.n_design, tp.dt
+    n_m, n_d = chain.n_moving, chain.n_design
     y = ca.SX.sym("y", n_m + n_d)
-    s_W, f_W = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3)
+    s_W, f_W, k_w = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3), ca.SX.sym("k_w", 2)
+    h, tracked = k_w[0], k_w[1]
     w = problem.waypoint(y[:n_m], y[n_m:], s_W, f_W)
     phi = 0
     for cost in problem.waypoint_costs:
@@ -147,15 +168,24 @@ def waypoint_terms(problem: DesignProblem, activation: str, position_in_terms: b
         if not cost.quadratic:
             phi += cost(problem.chain, y[n_m:]) / tp.n
     penalty, c, lo, hi = tracking(w, s_W, activation, h * problem.tracking_weight, position_in_terms, epsilon)
-    phi += penalty
+    phi += tracked * penalty if activation == "soft" and not tp.is_tracked.all() else penalty
     if problem.keep_out_radius > 0:
         s_B = w.T_BW[:3, :3] @ s_W + w.T_BW[:3, 3]
         c.append(s_B[0] ** 2 + s_B[1] ** 2)
         lo.append(problem.keep_out_radius**2)
         hi.append(np.inf)
-    fn = ca.Function("terms", [y, s_W, f_W], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
-                     ["y", "s_W", "f_W"], ["phi", "c"])
+    fn = ca.Function("terms", [y, s_W, f_W, k_w], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
+                     ["y", "s_W", "f_W", "k_w"], ["phi", "c"])
     return fn, np.array(lo), np.array(hi)
+
+
+def tracking_rows(problem: DesignProblem, activation: str, position_in_terms: bool = True) -> np.ndarray:
+    """Indices of the tracking constraints among the rows of `waypoint_terms`' c."""
+    if activation == "epsilon":
+        return np.array([0])
+    if activation == "soft":
+        return np.zeros(0, dtype=int)
+    return np.arange(6 if position_in_terms else 3)
 
 
 def quadratic_design_costs(problem: DesignProblem, q_d):
