@@ -31,36 +31,67 @@ Pair = tuple[float, float]
 Positive = Annotated[float, Field(gt=0)]
 
 
+class MillingForce(_Strict):
+    """A milling force model (designopt.forces): Kienzle per tooth, averaged over a revolution. Lengths in m."""
+
+    model: Literal["milling"]
+    material: Literal["aluminium", "steel_c45"] = "aluminium"
+    kc11: Positive | None = Field(None, description="N/mm^2; overrides the material's")
+    mc: Annotated[float, Field(ge=0, lt=1)] | None = None
+    radial_ratio: Annotated[float, Field(ge=0)] | None = None
+    axial_ratio: Annotated[float, Field(ge=0)] | None = None
+    tool_diameter: Positive = 0.010
+    teeth: Annotated[int, Field(ge=1, le=50)] = 3
+    feed_per_tooth: Positive = 5.0e-5
+    axial_depth: Positive = 1.0e-3
+    radial_width: Positive | None = None  # None: a full slot
+    direction: Literal["down", "up"] = "down"
+
+
+Force = Positive | MillingForce  # a number: the paper's alpha (N), F = alpha * tangent
+
+
 class FigureEight(_Strict):
     kind: Literal["figure_eight"]
     width: Positive = 0.6
     height: Positive = 0.3
     waypoints: Annotated[int, Field(ge=3, le=5000)] = 80
-    force: Positive = 1.0
+    force: Force = 1.0
 
 
 class Circle(_Strict):
     kind: Literal["circle"]
     radius: Positive = 0.15
     waypoints: Annotated[int, Field(ge=3, le=5000)] = 80
-    force: Positive = 1.0
+    force: Force = 1.0
 
 
 class Line(_Strict):
     kind: Literal["line"]
     length: Positive = 0.5
     waypoints: Annotated[int, Field(ge=3, le=5000)] = 80
-    force: Positive = 1.0
+    force: Force = 1.0
 
 
 class CsvPath(_Strict):
     kind: Literal["csv"]
     file: str
     waypoints: Annotated[int, Field(ge=3, le=5000)] | None = None
-    force: Positive = 1.0
+    force: Force = 1.0
 
 
-ToolpathConfig = Annotated[FigureEight | Circle | Line | CsvPath, Field(discriminator="kind")]
+class GcodePath(_Strict):
+    """A G-code program (designopt.gcode): cutting moves tracked and loaded, rapids free. Lengths in m."""
+
+    kind: Literal["gcode"]
+    file: str
+    spacing: Positive = 2.0e-3  # largest distance between waypoints along the path
+    chord_tolerance: Positive = 1.0e-4  # arcs are sampled so no chord leaves the arc by more
+    rapid_speed: Positive = 0.25  # m/s, the speed of G0 moves when the program gives feeds
+    force: Force = 1.0
+
+
+ToolpathConfig = Annotated[FigureEight | Circle | Line | CsvPath | GcodePath, Field(discriminator="kind")]
 
 
 class StiffnessConfig(_Strict):
@@ -205,6 +236,27 @@ class ModularConfig(_Strict):
     enumeration_waypoints: Annotated[int, Field(ge=3)] = 40
 
 
+class BlockConfig(_Strict):
+    size: tuple[Positive, Positive, Positive] = (0.1, 0.1, 0.05)  # x, y extents and height (m)
+    center: tuple[float, float] = (0.0, 0.0)  # x, y of the top face's centre in W (m)
+
+
+class ToolConfig(_Strict):
+    length: Positive = 0.1  # m, from the robot's tool frame along its z axis to the tool centre point
+    radius: Positive = 0.005
+
+
+class CellConfig(_Strict):
+    """The production cell (designopt.clearance): a block under the path, a floor, link capsules and a tool."""
+
+    block: BlockConfig = BlockConfig()
+    floor: float = -1.0  # z of the floor in the base frame (m)
+    clearance: Annotated[float, Field(ge=0)] = 0.01  # m, between any link capsule and block or floor
+    link_radius: Positive | list[Positive] = 0.05  # m; a list: one per link, base link first (n_moving + 1)
+    tool: ToolConfig = ToolConfig()
+    samples: Annotated[int, Field(ge=2, le=50)] = 9  # points per skeleton segment for the block constraint
+
+
 class Config(_Strict):
     name: Annotated[str, Field(pattern=r"^[A-Za-z0-9_.-]+$")] = "run"
     toolpath: ToolpathConfig = FigureEight(kind="figure_eight")
@@ -215,6 +267,7 @@ class Config(_Strict):
     solver: SolverConfig = SolverConfig()
     continuous: ContinuousConfig = ContinuousConfig()
     modular: ModularConfig = ModularConfig()
+    cell: CellConfig | None = None  # no cell: nothing keeps the robot out of the workpiece or the floor
     # Where the config came from: errors found later (building the problem) name this file, and relative
     # paths in it (a CSV toolpath) resolve against its directory.
     _file: str = PrivateAttr("<config>")
@@ -290,7 +343,7 @@ def _semantic_errors(cfg: Config, base_dir: Path) -> list[tuple[str, str]]:
         if k > n_modules:
             errors.append(("modular.enumeration_modules", f"module {k} does not exist (the catalogue has "
                                                           f"{n_modules})"))
-    if cfg.toolpath.kind == "csv":
+    if cfg.toolpath.kind in ("csv", "gcode"):
         path = (base_dir / cfg.toolpath.file).resolve()
         if not path.is_file():
             errors.append(("toolpath.file", f"no such file: {path}"))

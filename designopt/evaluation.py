@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from designopt import costs
+from designopt.clearance import Clearance, min_clearance
 from designopt.costs import deformation_term, tracking_residual
 from designopt.problem import DesignProblem
 
@@ -36,6 +37,7 @@ class Metrics:
     axis_error: np.ndarray
     min_standoff: float
     costs: tuple[tuple[str, float], ...] = ()
+    clearance: Clearance | None = None  # with a cell: the smallest clearance at knots and collocation points
 
     def row(self) -> dict:
         return {
@@ -47,6 +49,8 @@ class Metrics:
             "max_joint_step": self.max_joint_step,
             "tracks": self.tracks,
             "min_standoff": self.min_standoff,
+            **({"min_clearance": self.clearance.value, "clearance_link": self.clearance.link,
+                "clearance_obstacle": self.clearance.obstacle} if self.clearance is not None else {}),
         }
 
 
@@ -58,8 +62,23 @@ def max_joint_step(Q: np.ndarray) -> float:
     return float(np.max(np.abs(np.diff(Q, axis=0))))
 
 
-def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> Metrics:
-    """Evaluate a design q_d (n_d) and joint waypoints Q (N x n_m) on the problem's toolpath."""
+def trajectory_clearance(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, V: np.ndarray | None):
+    """The cell's smallest clearance at the waypoints and, given velocities V, at the collocation points
+    between them (the midpoints of the cubic Hermite segments)."""
+    from designopt.transcriptions.collocation import hermite_midpoint
+
+    configurations, indices = np.asarray(Q, dtype=float), np.arange(len(Q), dtype=float)
+    if V is not None:
+        h = problem.toolpath.h[:, None]
+        Q_mid, _ = hermite_midpoint(Q[:-1], V[:-1], Q[1:], V[1:], h)
+        configurations = np.vstack([configurations, Q_mid])
+        indices = np.concatenate([indices, np.arange(len(Q) - 1) + 0.5])
+    return min_clearance(problem.chain, problem.cell, q_d, configurations, indices)
+
+
+def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, V: np.ndarray | None = None) -> Metrics:
+    """Evaluate a design q_d (n_d) and joint waypoints Q (N x n_m) on the problem's toolpath (V, the joint
+    velocities at the waypoints, places the collocation points for the clearance check)."""
     chain, tp = problem.chain, problem.toolpath
     q_d = np.asarray(q_d, dtype=float)
     states = [problem.waypoint(Q[k], q_d, tp.points_W[k], tp.force_W[k]) for k in range(tp.n)]
@@ -87,4 +106,5 @@ def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> Metrics:
         axis_error=axis_err,
         min_standoff=float(min(np.hypot(s[0], s[1]) for s in s_B)),
         costs=tuple(values.items()),
+        clearance=trajectory_clearance(problem, q_d, Q, V) if problem.cell is not None else None,
     )

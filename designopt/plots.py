@@ -68,6 +68,28 @@ def draw_workpiece(ax, T_BW: np.ndarray, points_W: np.ndarray, margin: float = 0
     return corners_B
 
 
+def draw_cell(ax, sol: Solution, q: np.ndarray) -> np.ndarray:
+    """The cell of a solution: the workpiece block placed by T_BW and a patch of the floor under the robot and
+    the block. Returns the corners drawn (for axis limits)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    cell = sol.problem.cell
+    T_BW = placement_pose(sol.chain, q, np.zeros(0))
+    (sx, sy, sz), (cx, cy) = cell.block_size, cell.block_center
+    xs, ys, zs = (cx - sx / 2, cx + sx / 2), (cy - sy / 2, cy + sy / 2), (-sz, 0.0)
+    corners_W = np.array([[x, y, z] for z in zs for y in ys for x in xs])
+    c = corners_W @ T_BW[:3, :3].T + T_BW[:3, 3]
+    faces = [[c[0], c[1], c[3], c[2]], [c[4], c[5], c[7], c[6]], [c[0], c[1], c[5], c[4]],
+             [c[2], c[3], c[7], c[6]], [c[0], c[2], c[6], c[4]], [c[1], c[3], c[7], c[5]]]
+    ax.add_collection3d(Poly3DCollection(faces, facecolor="0.55", edgecolor="0.3", alpha=0.35,
+                                         label="workpiece block"))
+    reach = max(np.abs(c[:, :2]).max(), 0.3) * 1.15
+    floor = np.array([[-reach, -reach], [reach, -reach], [reach, reach], [-reach, reach]])
+    floor = np.column_stack([floor, np.full(4, cell.floor)])
+    ax.add_collection3d(Poly3DCollection([floor], facecolor="tan", edgecolor="0.5", alpha=0.2, label="floor"))
+    return np.vstack([c, floor])
+
+
 def _label_axes(ax) -> None:
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -78,6 +100,8 @@ def robot_figure(sol: Solution, title: str | None = None):
     fig = plt.figure(figsize=(5.5, 5))
     ax = fig.add_subplot(projection="3d")
     pts = draw_robot(ax, sol.chain, sol.raw.Q[0], sol.problem.toolpath.points_W)
+    if sol.problem.cell is not None:
+        pts = np.vstack([pts, draw_cell(ax, sol, sol.raw.Q[0])])
     _equal_3d(ax, np.vstack([pts, np.zeros((1, 3))]))
     _label_axes(ax)
     ax.set_title(title or f"{sol.problem.chain.structure}: design cost {sol.metrics.design_cost:.3g} (start pose)")
@@ -93,7 +117,7 @@ def joint_figure(sol: Solution):
         ax.plot(t, Q[:, i], label=f"q{i + 1} ({c})")
     axes[0].set_ylabel("revolute joints [rad]")
     axes[1].set_ylabel("prismatic joints [m]")
-    axes[1].set_xlabel("task time t [-]")
+    axes[1].set_xlabel(f"task time t [{'s' if sol.problem.toolpath.time_unit == 's' else '-'}]")
     for ax in axes:
         if ax.lines:
             ax.legend(fontsize=7, ncol=3)
@@ -111,19 +135,61 @@ def deformation_figure(sol: Solution):
     a0.set_title("Deformation cost along the path")
     fig.colorbar(sc, ax=a0, label="L_d")
     a1.plot(tp.t, m.deformation, color="C2")
-    a1.set_xlabel("task time t [-]")
+    a1.set_xlabel(f"task time t [{'s' if tp.time_unit == 's' else '-'}]")
     a1.set_ylabel(f"L_d ({sol.problem.deflection})")
     a1.set_title(f"design cost = sum dt L_d = {m.design_cost:.4g}")
     fig.tight_layout()
     return fig
 
 
+def deflection_by_component(sol: Solution) -> list[tuple[str, np.ndarray]]:
+    """|delta_i| (m per the stiffness units) at every waypoint caused by each named part of the force alone:
+    delta = J K^-1 J^T [f; 0] is linear in f, so the parts' deflections sum to the total (as vectors)."""
+    from designopt.kinematics.chain import geometric_jacobian
+
+    p, Q = sol.problem, sol.raw.Q
+    T_BW = placement_pose(sol.chain, Q[0], np.zeros(0))
+    k_inv = 1.0 / p.stiffness.diagonal(sol.chain.structure)
+    compliance = []
+    for q in Q:
+        J = geometric_jacobian(sol.chain, q, np.zeros(0))
+        compliance.append((J * k_inv) @ J.T)
+    out = []
+    for name, part in (*p.toolpath.force_parts, ("total", p.toolpath.force_W)):
+        f_B = part @ T_BW[:3, :3].T
+        delta = np.array([C[:3, :3] @ f for C, f in zip(compliance, f_B, strict=True)])
+        out.append((name, np.linalg.norm(delta, axis=1)))
+    return out
+
+
+def force_deflection_figure(sol: Solution):
+    """Which force component causes what: the force parts along the path and the tool deflection each causes."""
+    tp = sol.problem.toolpath
+    unit = "s" if tp.time_unit == "s" else "-"
+    fig, (a0, a1) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    for name, part in (*tp.force_parts, ("total", tp.force_W)):
+        a0.plot(tp.t, np.linalg.norm(part, axis=1), lw=2 if name == "total" else 1.2, label=name)
+    for name, delta in deflection_by_component(sol):
+        a1.plot(tp.t, delta * 1e6, lw=2 if name == "total" else 1.2, label=name)
+    a0.set_ylabel("|force| on the tool [N]")
+    a1.set_ylabel("tool deflection [um]")
+    a1.set_xlabel(f"task time t [{unit}]")
+    a0.set_title(f"Force components and the deflection each causes ({sol.problem.stiffness.describe()[:60]})",
+                 fontsize=8)
+    for ax in (a0, a1):
+        ax.legend(fontsize=7, ncol=4)
+    fig.tight_layout()
+    return fig
+
+
 def solution_figures(sol: Solution, directory: Path) -> list[Path]:
-    """The three standard figures of one solution."""
+    """The standard figures of one solution (and the force breakdown when the force has parts)."""
     out = []
     out += save(robot_figure(sol), directory, "robot")
     out += save(joint_figure(sol), directory, "joints")
     out += save(deformation_figure(sol), directory, "deformation")
+    if sol.problem.toolpath.force_parts:
+        out += save(force_deflection_figure(sol), directory, "force_deflection")
     return out
 
 
@@ -139,6 +205,8 @@ def render_figure(sol: Solution, frames: int = 6):
         drawn.append(draw_robot(ax, chain, Q[k], pts if n == 0 else None,
                                 color=cmap(0.35 + 0.65 * n / max(frames - 1, 1)),
                                 label=f"t = {t[k]:.2f}"))
+    if sol.problem.cell is not None:
+        drawn.append(draw_cell(ax, sol, Q[0]))
     _equal_3d(ax, np.vstack(drawn + [np.zeros((1, 3))]))
     _label_axes(ax)
     ax.set_title(f"{chain.structure} ({sol.method}): design cost {sol.metrics.design_cost:.3g}")

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from designopt import toolpaths
-from designopt.config import Config, dh_rows
+from designopt.clearance import Cell
+from designopt.config import Config, MillingForce, dh_rows
 from designopt.costs import (
     STIFFNESS_PRESETS,
     DesignCost,
@@ -24,6 +25,7 @@ from designopt.costs import (
 )
 from designopt.design_space import JointBounds, build_chain, placement_ets, placement_joints
 from designopt.errors import InputError
+from designopt.forces import MATERIALS, MillingProcess
 from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.joints import DH_PARAMS, Chain, Role
 
@@ -54,6 +56,7 @@ class DesignProblem:
     keep_out_radius: float = 0.0
     position_tol: float = 1.0e-3
     axis_tol: float = 1.0e-2
+    cell: Cell | None = None  # block, floor and capsules: clearance constraints (designopt.clearance)
 
     @property
     def k_inv(self) -> np.ndarray:
@@ -77,23 +80,55 @@ class DesignProblem:
         return waypoint(self.chain, q, q_d, s_W, f_W, self.k_inv, self.deflection)
 
 
+def milling_process(force: MillingForce) -> MillingProcess:
+    """The config's milling force model as a process of `designopt.forces`."""
+    base = MATERIALS[force.material]
+    overrides = {k: getattr(force, k) for k in ("kc11", "mc", "radial_ratio", "axial_ratio")
+                 if getattr(force, k) is not None}
+    material = replace(base, **overrides, source=base.source + (" (overridden: " + ", ".join(overrides) + ")"
+                                                                 if overrides else ""))
+    return MillingProcess(material, force.tool_diameter, force.teeth, force.feed_per_tooth, force.axial_depth,
+                          force.radial_width, force.direction)
+
+
 def toolpath_from_config(cfg: Config, base_dir: Path) -> toolpaths.Toolpath:
-    """The config's toolpath; a path that cannot define a task is a ConfigError (or an InputError naming
-    the line of a CSV file)."""
+    """The config's toolpath with its force model; a path that cannot define a task is a ConfigError (or an
+    InputError naming the line of a CSV or G-code file)."""
+    force = cfg.toolpath.force
+    path = _path_only(cfg, base_dir)
+    if isinstance(force, MillingForce):
+        if force.radial_width is not None and force.radial_width > force.tool_diameter:
+            raise cfg.error("toolpath.force.radial_width", f"{force.radial_width:g} m is wider than the tool "
+                                                           f"({force.tool_diameter:g} m)")
+        return toolpaths.with_force(path, milling_process(force))
+    return path
+
+
+def _path_only(cfg: Config, base_dir: Path) -> toolpaths.Toolpath:
     tp = cfg.toolpath
+    alpha = tp.force if isinstance(tp.force, float | int) else 1.0  # replaced by the milling model's force
+    if tp.kind == "gcode":
+        from designopt import gcode
+
+        program = gcode.read_program(base_dir / tp.file, tp.chord_tolerance)
+        sampled = gcode.sample_program(program, tp.spacing, tp.rapid_speed)
+        if len(sampled.t) > 5000:
+            raise cfg.error("toolpath.spacing", f"{tp.spacing:g} m gives {len(sampled.t)} waypoints (at most 5000): "
+                                                "choose a larger spacing")
+        return toolpaths.from_program(sampled, alpha)
     try:
         if tp.kind == "figure_eight":
-            return toolpaths.figure_eight(tp.width, tp.height, tp.waypoints, tp.force)
+            return toolpaths.figure_eight(tp.width, tp.height, tp.waypoints, alpha)
         if tp.kind == "circle":
-            return toolpaths.circle(tp.radius, tp.waypoints, tp.force)
+            return toolpaths.circle(tp.radius, tp.waypoints, alpha)
         if tp.kind == "line":
-            return toolpaths.line(tp.length, tp.waypoints, tp.force)
+            return toolpaths.line(tp.length, tp.waypoints, alpha)
         path = base_dir / tp.file
         points = toolpaths.read_csv(path)
         if tp.waypoints is None and len(points) < 3:
             raise InputError(path, "(file)", f"{len(points)} points make {len(points)} waypoints, a path needs at "
                                              "least 3: add points, or set toolpath.waypoints to resample")
-        return toolpaths.from_points(points, tp.waypoints, tp.force)
+        return toolpaths.from_points(points, tp.waypoints, alpha)
     except toolpaths.ToolpathError as exc:
         raise cfg.error("toolpath", str(exc)) from None
 
@@ -181,6 +216,9 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         placement_box=cfg.placement.box,
     )
     chain = robot_chain(cfg, base_dir, bounds)
+    cell = cell_from_config(cfg, chain)
+    if cell is not None:
+        chain = with_tool_length(chain, cell.tool_length)
     check_start_values(cfg, chain)
     toolpath = toolpath_from_config(cfg, base_dir)
     check_standoff(cfg, chain, toolpath)
@@ -201,4 +239,34 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         keep_out_radius=cfg.placement.keep_out_radius,
         position_tol=cfg.tolerance.position,
         axis_tol=cfg.tolerance.axis,
+        cell=cell,
     )
+
+
+def with_tool_length(chain: Chain, length: float) -> Chain:
+    """The chain with its tool centre point moved ``length`` along the tool z axis (the cell's tool)."""
+    tool = np.array(chain.tool, dtype=float) @ np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, length],
+                                                         [0, 0, 0, 1.0]])
+    return replace(chain, tool=tuple(tuple(float(v) for v in row) for row in tool))
+
+
+def cell_from_config(cfg: Config, chain: Chain) -> Cell | None:
+    """The config's cell, checked against the robot: one radius per link, the base above the floor, a tool
+    long enough for the last link to clear the block."""
+    c = cfg.cell
+    if c is None:
+        return None
+    radii = (c.link_radius,) * (chain.n_moving + 1) if isinstance(c.link_radius, float | int) \
+        else tuple(c.link_radius)
+    if len(radii) != chain.n_moving + 1:
+        raise cfg.error("cell.link_radius", f"{len(radii)} radii for {chain.n_moving + 1} links (the base link and "
+                                            f"one per moving joint)")
+    if c.floor > -(radii[0] + c.clearance):
+        raise cfg.error("cell.floor", f"{c.floor:g} m: the base link (radius {radii[0]:g} m) stands at z = 0 and "
+                                      f"must clear the floor by {c.clearance:g} m")
+    if c.tool.length <= radii[-1] + c.clearance:
+        raise cfg.error("cell.tool.length", f"{c.tool.length:g} m: the last link (radius {radii[-1]:g} m) ends "
+                                            "where the tool begins, so the tool must be longer than that radius plus "
+                                            f"the clearance ({radii[-1] + c.clearance:g} m)")
+    return Cell(tuple(c.block.size), tuple(c.block.center), c.floor, c.clearance, radii, c.tool.length,
+                c.tool.radius, c.samples)

@@ -21,7 +21,8 @@ SUMMARY_COLUMNS = [
     "design_cost", "max_position_error", "max_axis_error", "max_joint_step", "tracks", "best",
     "status", "success", "iterations", "solve_time_s", "build_time_s", "n_variables", "n_constraints",
     "objective", "regularization", "min_standoff", "kinematic_drift", "seed",
-    "stiffness_revolute", "stiffness_prismatic", "deflection", "solution_file",
+    "stiffness_revolute", "stiffness_prismatic", "deflection", "min_clearance", "clearance_link",
+    "clearance_obstacle", "solution_file",
 ]
 # ...plus one cost_<name> column per named term of the objective (before solution_file), as rows bring them.
 

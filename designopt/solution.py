@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from designopt.clearance import Cell
 from designopt.costs import Stiffness
 from designopt.evaluation import Metrics, evaluate
 from designopt.kinematics.joints import DH_PARAMS, Chain, Role
@@ -75,9 +76,10 @@ class Solution:
                                 stiffness=Stiffness(per_joint=tuple(float(v) for v in data["stiffness"])),
                                 deflection=m["deflection"],
                                 position_tol=tol.get("position", 1e-3), axis_tol=tol.get("axis", 1e-2),
-                                joint_velocity=float(limits[0].get("velocity_per_task_time", 10.0)))
+                                joint_velocity=float(limits[0].get("velocity_per_task_time", 10.0)),
+                                cell=cell_from_dict(data["cell"]) if "cell" in data else None)
         raw = _raw_from_file(data, np.zeros(0))
-        return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, raw.Q))
+        return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, raw.Q, raw.V))
 
     def sample(self, t) -> np.ndarray:
         """Joint values q(t) (len(t) x n_m) at task times t in [0, 1].
@@ -125,7 +127,7 @@ class Solution:
 
 
 def solve_and_evaluate(problem: DesignProblem, method: str, raw: RawResult, label: str = "") -> Solution:
-    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.Q), label)
+    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.Q, raw.V), label)
 
 
 def _finite(x: float) -> float | None:
@@ -147,6 +149,19 @@ def robot_description(chain: Chain) -> dict:
     return {"ets": [{"motion": et.motion, "axis": list(et.axis),
                      "value": None if chain.joints[et.joint].role is Role.MOVING else float(values[et.joint])}
                     for et in chain.robot]}
+
+
+def cell_to_dict(cell: Cell) -> dict:
+    """The cell as a solution file carries it (metres; block in W, floor in B, one radius per link)."""
+    return {"block": {"size": list(cell.block_size), "center": list(cell.block_center)}, "floor": cell.floor,
+            "clearance": cell.clearance, "link_radius": list(cell.link_radius),
+            "tool": {"length": cell.tool_length, "radius": cell.tool_radius}, "samples": cell.samples}
+
+
+def cell_from_dict(data: dict) -> Cell:
+    return Cell(tuple(data["block"]["size"]), tuple(data["block"]["center"]), float(data["floor"]),
+                float(data["clearance"]), tuple(float(r) for r in data["link_radius"]), float(data["tool"]["length"]),
+                float(data["tool"]["radius"]), int(data.get("samples", 9)))
 
 
 def to_dict(sol: Solution) -> dict:
@@ -172,6 +187,7 @@ def to_dict(sol: Solution) -> dict:
             "force_model": p.toolpath.force_model,
             **({"tracked": p.toolpath.is_tracked.tolist()} if p.toolpath.tracked is not None else {}),
         },
+        **({"cell": cell_to_dict(p.cell)} if p.cell is not None else {}),
         "q": np.asarray(r.Q).tolist(),
         # joint velocities dq/dt at the waypoints (TO's Hermite knots; absent for FK): with q they define
         # the trajectory between waypoints
@@ -193,6 +209,8 @@ def to_dict(sol: Solution) -> dict:
             "costs": {name: value for name, value in m.costs},
             "cost_weights": {c.name: c.weight for c in (*p.waypoint_costs, *p.design_costs)},
             "min_standoff": m.min_standoff,
+            **({"clearance": {"min": m.clearance.value, "link": m.clearance.link, "obstacle": m.clearance.obstacle,
+                              "time_index": m.clearance.time_index}} if m.clearance is not None else {}),
             "kinematic_drift": r.kinematic_drift,
             "objective": _finite(r.objective),
             "success": r.success,
@@ -245,7 +263,7 @@ def read_solution_for(problem: DesignProblem, method: str, path: Path, label: st
         if isinstance(exc, SolutionLoadError):
             raise
         raise SolutionLoadError(f"{path}: {exc}") from None
-    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.Q), label)
+    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.Q, raw.V), label)
 
 
 def _raw_from_file(data: dict, q_d: np.ndarray) -> RawResult:

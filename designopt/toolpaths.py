@@ -40,6 +40,8 @@ class Toolpath:
     tracked: np.ndarray | None = None
     time_unit: str = "task"
     force_model: str = "paper"  # "paper": alpha * tangent (SPEC §3); "milling": designopt.forces
+    # the force split into named parts (e.g. feed, feed-normal, axial), each (N, 3) in W, summing to force_W
+    force_parts: tuple[tuple[str, np.ndarray], ...] = ()
 
     @property
     def n(self) -> int:
@@ -142,6 +144,24 @@ def from_points(points: np.ndarray, n: int | None = None, force: float = 1.0, ki
         if candidates:
             vel[k] = candidates[0]
     return _from_samples(kind, t, pts, vel, force)
+
+
+def with_force(tp: Toolpath, process) -> Toolpath:
+    """The toolpath with the milling model's force (`designopt.forces.MillingProcess`) at its tracked waypoints
+    instead of the paper's alpha * tangent; untracked waypoints carry no force."""
+    from designopt.forces import COMPONENTS, milling_force_components
+
+    parts = milling_force_components(process, tp.tangents_W) * tp.is_tracked[None, :, None]
+    return Toolpath(tp.kind, tp.t, tp.points_W, tp.tangents_W, parts.sum(axis=0), tp.tracked, tp.time_unit, "milling",
+                    tuple(zip(COMPONENTS, parts, strict=True)))
+
+
+def from_program(sampled, alpha: float = 1.0) -> Toolpath:
+    """A G-code program's waypoints (`designopt.gcode.SampledProgram`) with the paper's force alpha * tangent
+    on cutting moves and none on rapids."""
+    force = alpha * sampled.tangents * sampled.tracked[:, None]
+    return Toolpath("gcode", sampled.t, sampled.points, sampled.tangents, force, sampled.tracked,
+                    sampled.time_unit)
 
 
 def read_csv(path: Path) -> np.ndarray:

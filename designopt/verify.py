@@ -125,6 +125,8 @@ def _check_rest(data: dict, n: int, file) -> None:
         raise SolutionFileError(file, "toolpath.tracked", f"expected {len(points)} true/false values, at least one "
                                                           "true")
     _array(data, "q", (len(points), n), file)
+    if "cell" in data:
+        _check_cell(data, n, file)
     metrics = data.get("metrics")
     if not isinstance(metrics, dict):
         raise SolutionFileError(file, "metrics", "missing")
@@ -211,6 +213,94 @@ def _robot_walk(data: dict, q) -> tuple:
     return T, origins, axes, kinds
 
 
+def _skeleton(data: dict, q, tool_length: float) -> tuple[list, list]:
+    """The robot's capsule skeleton in B: the base origin, the point after every translation of nonzero length,
+    the robot's own tool frame (``tool_length`` short of the tool centre point); and each segment's link."""
+    T, points, links, moved = np.eye(4), [np.zeros(3)], [], 0
+    q = iter(q)
+
+    def add(point):
+        if np.linalg.norm(point - points[-1]) > 1e-12:
+            points.append(point)
+            links.append(moved)
+
+    if "dh" in data:
+        for row in data["dh"]:
+            moved += 1
+            value = next(q)
+            theta = value if row["type"] == "R" else row["theta"]
+            d = value if row["type"] == "P" else row["d"]
+            add(T[:3, 3] + d * T[:3, 2])
+            T = T @ _dh(theta, d, row["a"], row["alpha"])
+            add(T[:3, 3].copy())
+    else:
+        for et in data["ets"]:
+            value = et["value"]
+            if value is None:
+                value = next(q)
+                moved += 1
+            T = T @ (rotation(et["axis"], value) if et["motion"] == "rotate" else translation(et["axis"], value))
+            if et["motion"] == "translate":
+                add(T[:3, 3].copy())
+    tool = np.array(data["tool"], dtype=float)
+    add((T @ tool @ translation([0, 0, 1], -tool_length))[:3, 3])
+    return points, links
+
+
+def _configurations(data: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Joint values at the waypoints and, with velocities in the file, at the collocation points (the midpoints
+    of the cubic Hermite segments); and their waypoint indices (k + 0.5 for a midpoint)."""
+    Q = np.array(data["q"], dtype=float)
+    index = np.arange(len(Q), dtype=float)
+    if "v" not in data:
+        return Q, index
+    V = np.array(data["v"], dtype=float)
+    t = np.array(data["toolpath"].get("t", np.linspace(0, 1, len(Q))), dtype=float)
+    h = np.diff(t)[:, None]
+    mid = 0.5 * (Q[:-1] + Q[1:]) + h * (V[:-1] - V[1:]) / 8.0
+    return np.vstack([Q, mid]), np.concatenate([index, np.arange(len(Q) - 1) + 0.5])
+
+
+def clearance(data: dict) -> tuple[float, int, str]:
+    """The smallest distance (m) of any link capsule from the block or the floor, recomputed with coal (the FCL
+    extension) from the file's robot, placement, cell and trajectory: (distance, link, "block" or "floor")."""
+    import coal
+
+    cell = data["cell"]
+    radii, L = cell["link_radius"], float(cell["tool"]["length"])
+    T_BW = _placement(data)
+    sx, sy, sz = cell["block"]["size"]
+    cx, cy = cell["block"]["center"]
+    box = coal.Box(float(sx), float(sy), float(sz))
+    box_pose = coal.Transform3s(T_BW[:3, :3], T_BW[:3, :3] @ np.array([cx, cy, -sz / 2]) + T_BW[:3, 3])
+    floor = coal.Halfspace(np.array([0.0, 0.0, 1.0]), float(cell["floor"]))
+    identity = coal.Transform3s()
+    best = (np.inf, -1, "")
+    for q in _configurations(data)[0]:
+        points, links = _skeleton(data, q, L)
+        for a, b, link in zip(points[:-1], points[1:], links, strict=True):
+            axis = b - a
+            length = float(np.linalg.norm(axis))
+            z = axis / length
+            x = np.cross(z, [1.0, 0, 0]) if abs(z[0]) < 0.9 else np.cross(z, [0, 1.0, 0])
+            x /= np.linalg.norm(x)
+            pose = coal.Transform3s(np.column_stack([x, np.cross(z, x), z]), (a + b) / 2)
+            capsule = coal.Capsule(float(radii[min(link, len(radii) - 1)]), length)
+            for shape, shape_pose, what in ((box, box_pose, "block"), (floor, identity, "floor")):
+                d = coal.distance(capsule, pose, shape, shape_pose, coal.DistanceRequest(), coal.DistanceResult())
+                if d < best[0]:
+                    best = (float(d), link, what)
+    return best
+
+
+def _placement(data: dict) -> np.ndarray:
+    x, y, z = data["placement"]["xyz"]
+    yaw, pitch, roll = data["placement"]["ypr"]
+    T_BW = np.eye(4)
+    T_BW[:3, 3] = (x, y, z)
+    return T_BW @ _rot("z", yaw) @ _rot("y", pitch) @ _rot("x", roll)
+
+
 @dataclass(frozen=True)
 class Check:
     design_cost: float
@@ -259,6 +349,22 @@ def recompute(data: dict, position_tol: float = 1e-3, axis_tol: float = 1e-2, de
     return Check(cost, pos_err, axis_err, pos_err <= position_tol and axis_err <= axis_tol)
 
 
+def _check_cell(data: dict, n: int, file) -> None:
+    if not isinstance(data["cell"], dict):
+        raise SolutionFileError(file, "cell", "expected a mapping")
+    if np.any(_array(data, "cell.block.size", (3,), file) <= 0):
+        raise SolutionFileError(file, "cell.block.size", "every extent must be > 0")
+    _array(data, "cell.block.center", (2,), file)
+    _array(data, "cell.floor", (), file)
+    if _array(data, "cell.clearance", (), file) < 0:
+        raise SolutionFileError(file, "cell.clearance", "must be >= 0")
+    if np.any(_array(data, "cell.link_radius", (n + 1,), file) <= 0):
+        raise SolutionFileError(file, "cell.link_radius", "every radius must be > 0")
+    if _array(data, "cell.tool.length", (), file) <= 0:
+        raise SolutionFileError(file, "cell.tool.length", "must be > 0")
+    _array(data, "metrics.clearance.min", (), file)
+
+
 def problems(data: dict, rtol: float = 1e-6) -> list[tuple[str, str]]:
     """(key, reason) for every reported number that does not follow from the file's own data."""
     found = []
@@ -280,6 +386,12 @@ def problems(data: dict, rtol: float = 1e-6) -> list[tuple[str, str]]:
         found.append(("metrics.max_axis_error", f"{m['max_axis_error']} != recomputed {check.max_axis_error}"))
     if check.tracks != m["tracks"]:
         found.append(("metrics.tracks", f"{m['tracks']} != recomputed {check.tracks}"))
+    if "cell" in data:
+        reported = m.get("clearance", {}).get("min")
+        value, link, what = clearance(data)
+        if reported is None or not np.isclose(value, reported, rtol=0.0, atol=1e-6):
+            found.append(("metrics.clearance.min", f"{reported} != {value:.9g} recomputed with coal ({what}, link "
+                                                   f"{link})"))
     return found
 
 

@@ -11,7 +11,8 @@ ROOT = Path(__file__).resolve().parent.parent
 # Lower layers never import higher ones. Within a layer, modules may import each other (acyclically).
 LAYERS = [
     ("designopt.errors", "designopt.kinematics", "designopt.toolpaths", "designopt.design_space",
-     "designopt.costs", "designopt.modular", "designopt.verify"),
+     "designopt.costs", "designopt.modular", "designopt.verify", "designopt.forces", "designopt.gcode",
+     "designopt.clearance"),
     ("designopt.config",),
     ("designopt.problem",),
     ("designopt.transcriptions", "designopt.initial_guess"),

@@ -27,6 +27,8 @@ from designopt.transcriptions.nlp import (
     BlockStructure,
     ConstraintList,
     WaypointNLP,
+    clearance_terms,
+    floor_terms,
     free_untracked,
     joint_regularization,
     once_only_rows,
@@ -102,7 +104,11 @@ class CollocationNLP:
 
         q_d = ca.SX.sym("q_d", n_d)
         Z = ca.SX.sym("Z", self.n_state, N)  # column k: (q_k, v_k[, p_k])
-        x = ca.vertcat(q_d, ca.vec(Z))
+        # With a cell, the collocation points' joints are variables too (M, tied to the cubic by linear
+        # equalities), so that the clearance there is a per-point term the structured Hessian covers.
+        self.n_mid = n_m * (N - 1) if problem.cell is not None else 0
+        M = ca.SX.sym("M", n_m, N - 1) if self.n_mid else None
+        x = ca.vertcat(q_d, ca.vec(Z), *([ca.vec(M)] if self.n_mid else []))
         Q, V = Z[:n_m, :], Z[n_m : 2 * n_m, :]
         S, F, K_w = waypoint_inputs(tp)
 
@@ -150,16 +156,36 @@ class CollocationNLP:
         vmax = problem.joint_velocity
         cons.add(Q_mid, np.tile(lo_m[:, None], (1, N - 1)), np.tile(hi_m[:, None], (1, N - 1)))
         cons.add(V_mid, -vmax, vmax)
+        cell_blocks = []
+        if problem.cell is not None:
+            cons.add(M - Q_mid, 0.0, 0.0)
+            clear = clearance_terms(problem)
+            n_cl = clear.size1_out(1)
+            mid_index = (n_d + N * self.n_state + np.arange(N - 1)[:, None] * n_m + np.arange(n_m)[None, :])
+            for points, at, count in ((Q, y_indices(n_d, n_m, N, self.n_state), N),
+                                      (M, np.hstack([mid_index, np.tile(np.arange(n_d), (N - 1, 1))]), N - 1)):
+                first = cons.size
+                cons.add(clear.map(count)(ca.vertcat(points, ca.repmat(q_d, 1, count)))[1], 0.0, np.inf)
+                cell_blocks.append(BlockStructure(clear, at, first + np.arange(count * n_cl).reshape(count, n_cl),
+                                                  scheme.compile, ()))
+            floor = floor_terms(problem)
+            first = cons.size
+            cons.add(floor(q_d)[1], 0.0, np.inf)
+            cell_blocks.append(BlockStructure(floor, np.arange(n_d)[None, :],
+                                              first + np.arange(floor.size1_out(1))[None, :], scheme.compile, ()))
 
         n_free = self.n_state - 2 * n_m
         state_lo = np.concatenate([lo_m, -vmax * np.ones(n_m), -np.inf * np.ones(n_free)])
         state_hi = np.concatenate([hi_m, vmax * np.ones(n_m), np.inf * np.ones(n_free)])
-        lbx = np.concatenate([[j.lower for j in chain.design], np.tile(state_lo, N)])
-        ubx = np.concatenate([[j.upper for j in chain.design], np.tile(state_hi, N)])
+        mid_lo, mid_hi = np.tile(lo_m, N - 1)[: self.n_mid], np.tile(hi_m, N - 1)[: self.n_mid]
+        lbx = np.concatenate([[j.lower for j in chain.design], np.tile(state_lo, N), mid_lo])
+        ubx = np.concatenate([[j.upper for j in chain.design], np.tile(state_hi, N), mid_hi])
         blocks = None
         if scheme.hessian == "structured" and not differential:
-            blocks = BlockStructure(terms, y_indices(n_d, n_m, N, self.n_state), np.arange(N * n_c).reshape(N, n_c),
-                                    scheme.compile)
+            blocks = [BlockStructure(terms, y_indices(n_d, n_m, N, self.n_state), np.arange(N * n_c).reshape(N, n_c),
+                                     scheme.compile), *cell_blocks]
+        elif problem.cell is not None:
+            raise ValueError("clearance constraints need the structured Hessian and forward kinematics")
         self.nlp = WaypointNLP(problem, "to", x, objective, quadratic, cons, lbx, ubx, blocks, scheme.max_iter,
                                scheme.ipopt, t0)
         self.solver, self.lbx, self.ubx = self.nlp.solver, self.nlp.lbx, self.nlp.ubx
@@ -175,13 +201,17 @@ class CollocationNLP:
         if self.scheme.kinematics == "differential":
             blocks.append(np.asarray(p.toolpath.points_W))
         Z = np.hstack(blocks)  # row k = column k of the symbolic Z
-        return np.concatenate([np.asarray(guess.q_d, dtype=float), Z.ravel()])
+        mid = []
+        if self.n_mid:
+            h = p.toolpath.h[:, None]
+            mid = [hermite_midpoint(Q[:-1], V[:-1], Q[1:], V[1:], h)[0].ravel()]  # row k = column k of M
+        return np.concatenate([np.asarray(guess.q_d, dtype=float), Z.ravel(), *mid])
 
     def solve(self, guess: InitialGuess) -> RawResult:
         """Run IPOPT from one guess. A failed solve is a result with its status, not an exception."""
         x, objective, stats, wall = self.nlp.run(self._pack(guess))
         n_d, n_m, N = self.problem.chain.n_design, self.problem.chain.n_moving, self.problem.toolpath.n
-        Z = x[n_d:].reshape(N, self.n_state)
+        Z = x[n_d : n_d + N * self.n_state].reshape(N, self.n_state)
         drift = float(self._drift(x)) if self.scheme.kinematics == "differential" else 0.0
         return self.nlp.result(x[:n_d], Z[:, :n_m], Z[:, n_m : 2 * n_m], objective, stats, wall, guess.seed, drift)
 

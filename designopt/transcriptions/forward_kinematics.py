@@ -64,6 +64,8 @@ class ForwardKinematics:
 class ForwardKinematicsNLP:
     def __init__(self, problem: DesignProblem, scheme: ForwardKinematics):
         t0 = time.perf_counter()
+        if problem.cell is not None:
+            raise ValueError("the forward-kinematics baseline does not model the cell's clearance: use TO")
         self.problem, self.scheme = problem, scheme
         chain, tp = problem.chain, problem.toolpath
         n_m, n_d, N = chain.n_moving, chain.n_design, tp.n

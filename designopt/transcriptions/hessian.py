@@ -33,26 +33,25 @@ def block_hessian_function(terms: ca.Function, n_y: int, n_c: int, compile_mode:
 def assemble_hessian(
     n_x: int,
     n_g: int,
-    block: ca.Function,
-    y_index: np.ndarray,
-    block_inputs: list,
-    mu_index: np.ndarray,
+    groups: list[tuple[ca.Function, np.ndarray, list, np.ndarray]],
     constant: np.ndarray,
 ) -> ca.Function:
     """hess_lag(x, p, lam_f, lam_g) -> triu Hessian, for nlpsol's ``hess_lag`` option.
 
-    ``y_index`` (N x n_y) gives the position in x of each block variable; ``mu_index`` (N x n_c) the
-    position in lam_g of each block multiplier; ``block_inputs`` the block's constant extra inputs (mapped);
-    ``constant`` is the dense Hessian of the quadratic terms, scaled by lam_f.
+    Each group is (block, y_index, block_inputs, mu_index): a block Hessian function evaluated at N points,
+    ``y_index`` (N x n_y) the position in x of each block variable, ``mu_index`` (N x n_c) the position in
+    lam_g of each block multiplier, ``block_inputs`` the block's constant extra inputs (mapped). ``constant``
+    is the dense Hessian of the quadratic terms, scaled by lam_f. Contributions to one entry add up.
     """
-    N, n_y = y_index.shape
-    pairs = [(a, b) for a in range(n_y) for b in range(a, n_y)]
     rows, cols = [], []
-    for k in range(N):
-        for a, b in pairs:
-            i, j = y_index[k, a], y_index[k, b]
-            rows.append(min(i, j))
-            cols.append(max(i, j))
+    for _, y_index, _, _ in groups:
+        N, n_y = y_index.shape
+        pairs = [(a, b) for a in range(n_y) for b in range(a, n_y)]
+        for k in range(N):
+            for a, b in pairs:
+                i, j = y_index[k, a], y_index[k, b]
+                rows.append(min(i, j))
+                cols.append(max(i, j))
     c_rows, c_cols = np.nonzero(np.triu(constant))
     # CasADi stores nonzeros column by column: order the (row, col) pairs the same way.
     all_pairs = sorted(set(zip(rows, cols, strict=True)) | set(zip(c_rows, c_cols, strict=True)),
@@ -70,10 +69,13 @@ def assemble_hessian(
     p = ca.MX.sym("p", 0, 1)
     lam_f = ca.MX.sym("lam_f")
     lam_g = ca.MX.sym("lam_g", n_g)
-    Y = ca.reshape(x[ca.DM(y_index.T.ravel(order="F").tolist())], n_y, N)
-    mu = ca.reshape(lam_g[ca.DM(mu_index.T.ravel(order="F").tolist())], mu_index.shape[1], N) if mu_index.size \
-        else ca.MX(0, N)
-    values = block.map(N)(Y, lam_f, mu, *block_inputs)
-    nz = ca.mtimes(scatter, ca.vec(values)) + lam_f * ca.DM(const_vals)
+    values = []
+    for block, y_index, block_inputs, mu_index in groups:
+        N, n_y = y_index.shape
+        Y = ca.reshape(x[ca.DM(y_index.T.ravel(order="F").tolist())], n_y, N)
+        mu = ca.reshape(lam_g[ca.DM(mu_index.T.ravel(order="F").tolist())], mu_index.shape[1], N) \
+            if mu_index.size else ca.MX(0, N)
+        values.append(ca.vec(block.map(N)(Y, lam_f, mu, *block_inputs)))
+    nz = ca.mtimes(scatter, ca.vertcat(*values)) + lam_f * ca.DM(const_vals)
     H = ca.MX(sp, nz)
     return ca.Function("hess_lag", [x, p, lam_f, lam_g], [H], ["x", "p", "lam_f", "lam_g"], ["hess"])

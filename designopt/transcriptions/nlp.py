@@ -34,38 +34,47 @@ class ConstraintList:
         self.lo.append(np.broadcast_to(np.ravel(lo, order="F"), expr.shape[0]))
         self.hi.append(np.broadcast_to(np.ravel(hi, order="F"), expr.shape[0]))
 
+    @property
+    def size(self) -> int:
+        """Rows so far: the lam_g index of the next row added."""
+        return sum(g.shape[0] for g in self.g)
+
     def stacked(self):
         return ca.vertcat(*self.g), np.concatenate(self.lo), np.concatenate(self.hi)
 
 
 @dataclass(frozen=True)
 class BlockStructure:
-    """Where the per-waypoint terms sit: x indices of each y_k and lam_g indices of each c_k."""
+    """Where per-point terms sit: x indices of each y_k and lam_g indices of each c_k; ``inputs`` are the terms'
+    constant inputs after y (one column per point; None: the toolpath's `waypoint_inputs`)."""
 
     terms: ca.Function
     y_index: np.ndarray
     mu_index: np.ndarray
     compile: str
+    inputs: tuple | None = None
 
 
 class WaypointNLP:
     """An IPOPT problem whose nonlinear terms are per-waypoint blocks (plus quadratic terms)."""
 
     def __init__(self, problem: DesignProblem, name: str, x, objective, quadratic, constraints: ConstraintList,
-                 lbx, ubx, blocks: BlockStructure | None, max_iter: int, ipopt: dict | None, t_start: float):
+                 lbx, ubx, blocks: BlockStructure | list[BlockStructure] | None, max_iter: int, ipopt: dict | None,
+                 t_start: float):
         self.problem = problem
         g, self.lbg, self.ubg = constraints.stacked()
         self.lbx, self.ubx = np.asarray(lbx, float), np.asarray(ubx, float)
         self.n_variables, self.n_constraints = x.shape[0], g.shape[0]
         opts = ipopt_options(max_iter, ipopt)
         if blocks is not None:
-            n_y, n_c = blocks.y_index.shape[1], blocks.mu_index.shape[1]
-            tp = problem.toolpath
+            groups = []
+            for b in [blocks] if isinstance(blocks, BlockStructure) else blocks:
+                block = block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1], b.compile)
+                inputs = list(waypoint_inputs(problem.toolpath) if b.inputs is None else b.inputs)
+                groups.append((block, b.y_index, inputs, b.mu_index))
             constant = np.array(ca.evalf(ca.hessian(quadratic, x)[0])) if not isinstance(quadratic, (int, float)) \
                 else np.zeros((x.shape[0], x.shape[0]))
-            block = block_hessian_function(blocks.terms, n_y, n_c, blocks.compile)
-            opts["hess_lag"] = assemble_hessian(self.n_variables, self.n_constraints, block, blocks.y_index,
-                                                list(waypoint_inputs(tp)), blocks.mu_index, constant)
+            opts["hess_lag"] = assemble_hessian(self.n_variables, self.n_constraints, groups, constant)
         self.solver = ca.nlpsol(name, "ipopt", {"x": x, "f": objective, "g": g}, opts)
         self.build_time_s = time.perf_counter() - t_start
 
@@ -186,6 +195,26 @@ def tracking_rows(problem: DesignProblem, activation: str, position_in_terms: bo
     if activation == "soft":
         return np.zeros(0, dtype=int)
     return np.arange(6 if position_in_terms else 3)
+
+
+def clearance_terms(problem: DesignProblem) -> ca.Function:
+    """y = (q, q_d) -> (phi = 0, c >= 0): the cell's clearance constraints at one configuration
+    (`designopt.clearance`), shaped like `waypoint_terms` so that the structured Hessian covers them."""
+    from designopt.clearance import constraint_terms
+
+    chain = problem.chain
+    y = ca.SX.sym("y", chain.n_moving + chain.n_design)
+    c = ca.vertcat(*constraint_terms(chain, problem.cell, y[: chain.n_moving], y[chain.n_moving :]))
+    return ca.Function("clearance", [y], [ca.SX(0), c], ["y"], ["phi", "c"])
+
+
+def floor_terms(problem: DesignProblem) -> ca.Function:
+    """q_d -> (phi = 0, c >= 0): the block stands on or above the floor (`designopt.clearance`)."""
+    from designopt.clearance import block_above_floor
+
+    q_d = ca.SX.sym("q_d", problem.chain.n_design)
+    c = ca.vertcat(*block_above_floor(problem.chain, problem.cell, q_d))
+    return ca.Function("block_floor", [q_d], [ca.SX(0), c], ["y"], ["phi", "c"])
 
 
 def quadratic_design_costs(problem: DesignProblem, q_d):

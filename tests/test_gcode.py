@@ -1,0 +1,152 @@
+"""G-code toolpaths against closed forms: arcs in every plane and direction, units, incremental mode, feeds as
+time, rapids untracked and unloaded; bad programs through the CLI are one line and exit 2."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from cli.main import app
+from designopt.config import parse_config
+from designopt.errors import InputError
+from designopt.evaluation import evaluate
+from designopt.gcode import parse_program, sample_program
+from designopt.initial_guess import initial_guess
+from designopt.problem import problem_from_config
+
+MM = 1e-3
+# plane -> (first, second, normal) axis indices and the offset words along the first two
+PLANES = {17: ((0, 1, 2), "IJ"), 18: ((2, 0, 1), "KI"), 19: ((1, 2, 0), "JK")}
+
+
+def _xyz(v) -> str:
+    return " ".join(f"{a}{c:g}" for a, c in zip("XYZ", v, strict=True))
+
+
+@pytest.mark.parametrize("plane", [17, 18, 19])
+@pytest.mark.parametrize("g", [2, 3])
+def test_arc_matches_its_closed_form(plane, g):
+    (a, b, n), (oa, ob) = PLANES[plane]
+    start = np.array([1.0, 2.0, 3.0])
+    centre = start.copy()
+    centre[a] += 5.0  # radius 5 mm, the start at angle pi in the plane's (a, b) coordinates
+    end = centre.copy()
+    end[b] += 5.0  # at angle pi/2
+    end[n] += 2.0  # a helix: the normal axis moves linearly
+    text = f"G21 G90 G{plane}\nG0 {_xyz(start)}\nG{g} {_xyz(end)} {oa}5 {ob}0 F600\n"
+    arc = parse_program(text, chord_tolerance=1e-3 * MM)[-1]
+    assert not arc.rapid
+    pts = arc.points / MM
+    u = pts[:, [a, b]] - centre[[a, b]]
+    np.testing.assert_allclose(np.linalg.norm(u, axis=1), 5.0, atol=1e-9)  # every vertex on the circle
+    np.testing.assert_allclose(pts[0], start, atol=1e-12)
+    np.testing.assert_allclose(pts[-1], end, atol=1e-12)
+    theta = np.unwrap(np.arctan2(u[:, 1], u[:, 0]))
+    sweep = theta[-1] - theta[0]
+    # from angle pi to pi/2: clockwise (G2) is the short quarter, counter-clockwise (G3) the long way round
+    assert sweep == pytest.approx(-math.pi / 2 if g == 2 else 3 * math.pi / 2, abs=1e-9)
+    assert np.all(np.diff(theta) < 0) if g == 2 else np.all(np.diff(theta) > 0)
+    # the normal coordinate is linear in the angle (helix), and no chord leaves the arc by more than the tolerance
+    np.testing.assert_allclose(pts[:, n], start[n] + 2.0 * (theta - theta[0]) / sweep, atol=1e-9)
+    sagitta = 5.0 * (1 - np.cos(np.abs(np.diff(theta)) / 2))
+    assert sagitta.max() <= 1e-3 + 1e-12
+
+
+@pytest.mark.parametrize(("r", "expected"), [(5.0, -math.pi / 2), (-5.0, -3 * math.pi / 2)])
+def test_radius_arcs_take_the_short_or_long_way(r, expected):
+    # G2 from (0, 0) to (5, 5) with |R| = 5: the short arc has its centre at (5, 0), the long one at (0, 5)
+    arc = parse_program(f"G21 G17\nG0 X0 Y0\nG2 X5 Y5 R{r:g} F100\n")[-1]
+    pts = arc.points[:, :2] / MM
+    centre = np.array([5.0, 0.0]) if r > 0 else np.array([0.0, 5.0])
+    np.testing.assert_allclose(np.linalg.norm(pts - centre, axis=1), 5.0, atol=1e-9)
+    theta = np.unwrap(np.arctan2(*(pts - centre).T[::-1]))
+    assert theta[-1] - theta[0] == pytest.approx(expected, abs=1e-9)
+
+
+def test_full_circle_and_units_and_incremental_mode():
+    circle = parse_program("G21\nG0 X10 Y0\nG3 X10 Y0 I-10 J0 F60\n")[-1]
+    theta = np.unwrap(np.arctan2(circle.points[:, 1], circle.points[:, 0]))
+    assert theta[-1] - theta[0] == pytest.approx(2 * math.pi)
+    inch = parse_program("G20 G90\nG1 X1 Y2 F10\n")[-1]
+    np.testing.assert_allclose(inch.points[-1], [0.0254, 0.0508, 0.0])
+    assert inch.feed == pytest.approx(10 * 0.0254 / 60)
+    incremental = parse_program("G21 G91\nG1 X10 F600\nX10 Y-5\nG90 X0\n")
+    np.testing.assert_allclose([m.points[-1] / MM for m in incremental], [[10, 0, 0], [20, -5, 0], [0, -5, 0]])
+
+
+def test_feeds_give_time_in_seconds_and_rapids_are_free():
+    text = "G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F300\nG1 X10 F600\nG0 Z5\nG0 X30\nG1 Z0 F300\nG1 X40 F600\n"
+    s = sample_program(parse_program(text), spacing=1 * MM, rapid_speed=0.1)
+    assert s.time_unit == "s"
+    # 5 mm at 5 mm/s, 10 mm at 10 mm/s, 5 + 20 mm of rapids at 100 mm/s, 5 mm at 5 mm/s, 10 mm at 10 mm/s
+    assert s.t[-1] == pytest.approx(1 + 1 + 0.25 + 1 + 1)
+    np.testing.assert_allclose(np.diff(s.t)[: 5], 0.2)  # 1 mm steps at 5 mm/s
+    assert np.all(np.linalg.norm(np.diff(s.points, axis=0), axis=1) <= 1 * MM + 1e-12)
+    rapid = (s.points[:, 2] > 0.5 * MM) & (s.points[:, 0] > 10.5 * MM) & (s.points[:, 0] < 29.5 * MM)
+    assert rapid.any() and not s.tracked[rapid].any()
+    cutting = np.isclose(s.points[:, 2], 0.0) & ((s.points[:, 0] <= 10 * MM) | (s.points[:, 0] >= 30 * MM))
+    assert s.tracked[cutting].all()
+
+
+def _pocket_problem(tmp_path: Path, force=1.0):
+    (tmp_path / "p.nc").write_text("G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F300\nG1 X20 F600\nG0 Z5\nG0 X40\nG1 Z0 F300\n"
+                                   "G1 Y20 F600\n")
+    cfg = parse_config({"toolpath": {"kind": "gcode", "file": "p.nc", "spacing": 0.004, "force": force},
+                        "robot": {"structure": "RRRRRR", "dh": "puma560", "design": []},
+                        "placement": {"optimize": False, "xyz": [0.45, 0.0, -0.2]}}, tmp_path / "c.yaml", tmp_path)
+    return problem_from_config(cfg, tmp_path)
+
+
+def test_a_design_that_leaves_the_path_on_a_rapid_still_tracks(tmp_path):
+    problem = _pocket_problem(tmp_path)
+    tp = problem.toolpath
+    assert (~tp.is_tracked).any()
+    np.testing.assert_array_equal(np.linalg.norm(tp.force_W, axis=1)[~tp.is_tracked], 0.0)  # unloaded
+    np.testing.assert_allclose(np.linalg.norm(tp.force_W, axis=1)[tp.is_tracked], 1.0)
+    guess = initial_guess(problem, 0, 0, 0.0, "ik")
+    assert evaluate(problem, guess.q_d, guess.Q).tracks
+    away = guess.Q.copy()
+    away[~tp.is_tracked] += 0.3  # leave the path (by ~0.1 m) wherever the tool is in a rapid
+    assert evaluate(problem, guess.q_d, away).tracks
+    cut = np.flatnonzero(tp.is_tracked)[3]
+    away[cut] += 0.3
+    assert not evaluate(problem, guess.q_d, away).tracks
+
+
+BAD_PROGRAMS = [
+    ("G21\nG1 X1 Q5 F100\n", "line 2", "Q5: unknown word"),
+    ("G21\nG1 X1 A30 F100\n", "line 2", "rotary"),
+    ("G21\nG0 X0 Y0\nG2 X10 Y0 I4 J0 F100\n", "line 3", "inconsistent"),
+    ("G21\nG0 X0 Y0\nG2 X30 Y0 R5 F100\n", "line 3", "no such arc"),
+    ("G21\nG0 X0 Y0\nG0 X5\n", "(file)", "no cutting move"),
+    ("G21\nG81 X1 Y1 Z-2 R1\n", "line 2", "G81 is not supported"),
+    ("G21\nG1 X1\nG1 X2 F100\n", "line 2", "before any F"),
+    ("G21\nG1 X1 F0\n", "line 2", "must be > 0"),
+    ("G21\nG1 X1 F100 Y#3\n", "line 2", "cannot read"),
+]
+
+
+@pytest.mark.parametrize(("program", "where", "reason"), BAD_PROGRAMS)
+def test_bad_programs_are_one_line_and_exit_2(tmp_path, program, where, reason):
+    (tmp_path / "bad.nc").write_text(program)
+    (tmp_path / "c.yaml").write_text("toolpath: {kind: gcode, file: bad.nc}\n")
+    result = CliRunner().invoke(app, ["check", str(tmp_path / "c.yaml")])
+    assert result.exit_code == 2, result.output
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.output
+    assert "bad.nc" in lines[0] and where in lines[0] and reason in lines[0], lines[0]
+
+
+def test_missing_program_file_is_a_config_error(tmp_path):
+    (tmp_path / "c.yaml").write_text("toolpath: {kind: gcode, file: nowhere.nc}\n")
+    result = CliRunner().invoke(app, ["check", str(tmp_path / "c.yaml")])
+    assert result.exit_code == 2 and "toolpath.file" in result.output and "no such file" in result.output
+
+
+def test_parse_errors_name_the_source():
+    with pytest.raises(InputError, match="prog.nc: line 1"):
+        parse_program("G1 X1 E5", "prog.nc")
