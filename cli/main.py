@@ -139,8 +139,13 @@ def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/
             joints.add_row(j.name, role, start, f"{j.lower:.6g}", f"{j.upper:.6g}",
                            "m" if j.kind == "length" else "rad")
     show(joints)
-    out.print(f"toolpath: {s.toolpath_kind}, {s.waypoints} waypoints, {s.path_length_m:.6g} m long, "
-              f"force {s.force_n:.6g} N along the tangent")
+    force = "along the tangent (the paper's model)" if s.force_model == "paper" else "at most (milling model)"
+    rapids = f" ({s.waypoints - s.tracked} on rapids, untracked)" if s.tracked < s.waypoints else ""
+    duration = f", {s.duration:.4g} s" if s.time_unit == "s" else ""
+    out.print(f"toolpath: {s.toolpath_kind}, {s.waypoints} waypoints{rapids}, {s.path_length_m:.6g} m long{duration}, "
+              f"force {s.force_n:.6g} N {force}")
+    if s.cell:
+        out.print(f"cell: {s.cell}")
     out.print(f"stiffness: {s.stiffness.describe()}; deflection: {s.deflection}")
     out.print(f"NLP (TO, {s.tracking} tracking, {s.kinematics} kinematics): {s.n_variables} variables, "
               f"{s.n_constraints} constraints; built in {s.build_time_s:.2f} s")

@@ -78,10 +78,27 @@ def urdf_model(data: dict, name: str = "designopt_cell", sphere_radius: float = 
         T[:3, 3] = p
         path_visuals.append(y.Visual(name=f"waypoint{k}", origin=T, geometry=y.Geometry(sphere=y.Sphere(sphere_radius)),
                                      material=red))
-    links.append(y.Link(name=WORKPIECE, visuals=path_visuals))
+    collisions, materials = [], [grey, red]
+    if "cell" in data:  # the workpiece block (its top face is W's z = 0) and the floor, as visuals and collisions
+        cell = data["cell"]
+        (sx, sy, sz), (cx, cy) = cell["block"]["size"], cell["block"]["center"]
+        stock = y.Material(name="stock", color=y.Color(rgba=np.array([0.6, 0.6, 0.62, 0.6])))
+        materials.append(stock)
+        T = np.eye(4)
+        T[:3, 3] = (cx, cy, -sz / 2)
+        block = y.Geometry(box=y.Box(np.array([sx, sy, sz], dtype=float)))
+        path_visuals.append(y.Visual(name="block", origin=T, geometry=block, material=stock))
+        collisions.append(y.Collision(name="block", origin=T, geometry=block))
+        F = np.eye(4)
+        F[:3, 3] = (0.0, 0.0, float(cell["floor"]) - 0.005)
+        floor = y.Geometry(box=y.Box(np.array([3.0, 3.0, 0.01])))
+        links.append(y.Link(name="floor", visuals=[y.Visual(name="floor", geometry=floor, material=stock)],
+                            collisions=[y.Collision(name="floor", geometry=floor)]))
+        joints.append(y.Joint(name="floor_mount", type="fixed", parent=BASE, child="floor", origin=F))
+    links.append(y.Link(name=WORKPIECE, visuals=path_visuals, collisions=collisions))
     joints.append(y.Joint(name="placement", type="fixed", parent=BASE, child=WORKPIECE,
                           origin=_origin(xyz, (ypr[2], ypr[1], ypr[0]))))
-    robot = y.Robot(name=name, links=links, joints=joints, materials=[grey, red])
+    robot = y.Robot(name=name, links=links, joints=joints, materials=materials)
     return y.URDF(robot=robot, build_scene_graph=True, load_meshes=False)
 
 

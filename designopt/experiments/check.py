@@ -32,6 +32,11 @@ class ProblemSummary:
     waypoints: int
     path_length_m: float
     force_n: float
+    force_model: str  # paper (alpha * tangent) or milling
+    tracked: int  # waypoints on cutting moves (the rest are rapids)
+    duration: float  # task time at the last waypoint (s when time_unit is s)
+    time_unit: str
+    cell: str  # the cell in words, or "" when there is none
     stiffness: Stiffness
     deflection: str
     tracking: str
@@ -40,6 +45,15 @@ class ProblemSummary:
     n_constraints: int
     build_time_s: float
     starts: int
+
+
+def _describe_cell(cell) -> str:
+    if cell is None:
+        return ""
+    sx, sy, sz = cell.block_size
+    return (f"block {sx:g} x {sy:g} x {sz:g} m under the path, floor at z = {cell.floor:g} m, clearance "
+            f"{cell.clearance:g} m, link radii {', '.join(f'{r:g}' for r in sorted(set(cell.link_radius)))} m, "
+            f"tool {cell.tool_length:g} m")
 
 
 def check_config(cfg: Config, base_dir: Path) -> ProblemSummary:
@@ -56,7 +70,9 @@ def check_config(cfg: Config, base_dir: Path) -> ProblemSummary:
         name=cfg.name, structure=chain.structure, moving=chain.moving, design=chain.design,
         n_fixed=len(chain.joints) - chain.n_moving - chain.n_design, toolpath_kind=tp.kind, waypoints=tp.n,
         path_length_m=float(np.linalg.norm(np.diff(tp.points_W, axis=0), axis=1).sum()),
-        force_n=float(np.linalg.norm(tp.force_W, axis=1).max()), stiffness=problem.stiffness,
+        force_n=float(np.linalg.norm(tp.force_W, axis=1).max()), force_model=tp.force_model,
+        tracked=int(tp.is_tracked.sum()), duration=float(tp.t[-1] - tp.t[0]), time_unit=tp.time_unit,
+        cell=_describe_cell(problem.cell), stiffness=problem.stiffness,
         deflection=problem.deflection, tracking=cfg.solver.tracking, kinematics=cfg.solver.kinematics,
         n_variables=nlp.n_variables, n_constraints=nlp.n_constraints, build_time_s=build,
         starts=cfg.solver.multistart,
