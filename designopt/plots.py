@@ -68,9 +68,10 @@ def draw_workpiece(ax, T_BW: np.ndarray, points_W: np.ndarray, margin: float = 0
     return corners_B
 
 
-def draw_cell(ax, sol: Solution, q: np.ndarray) -> np.ndarray:
+def draw_cell(ax, sol: Solution, q: np.ndarray, robot_points: np.ndarray | None = None) -> np.ndarray:
     """The cell of a solution: the workpiece block placed by T_BW and a patch of the floor under the robot and
-    the block. Returns the corners drawn (for axis limits)."""
+    the block. A floor far below everything else (more than the drawing's own height) would shrink the cell to
+    a speck: it is then named in the legend instead of drawn. Returns the corners drawn (for axis limits)."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     cell = sol.problem.cell
@@ -83,7 +84,12 @@ def draw_cell(ax, sol: Solution, q: np.ndarray) -> np.ndarray:
              [c[2], c[3], c[7], c[6]], [c[0], c[2], c[6], c[4]], [c[1], c[3], c[7], c[5]]]
     ax.add_collection3d(Poly3DCollection(faces, facecolor="0.55", edgecolor="0.3", alpha=0.35,
                                          label="workpiece block"))
-    reach = max(np.abs(c[:, :2]).max(), 0.3) * 1.15
+    drawn = c if robot_points is None else np.vstack([c, robot_points, np.zeros((1, 3))])
+    height = np.ptp(drawn[:, 2])
+    if drawn[:, 2].min() - cell.floor > max(height, 0.05):
+        ax.plot([], [], " ", label=f"floor at z = {cell.floor:g} m (below the view)")
+        return c
+    reach = np.abs(drawn[:, :2]).max() * 1.15
     floor = np.array([[-reach, -reach], [reach, -reach], [reach, reach], [-reach, reach]])
     floor = np.column_stack([floor, np.full(4, cell.floor)])
     ax.add_collection3d(Poly3DCollection([floor], facecolor="tan", edgecolor="0.5", alpha=0.2, label="floor"))
@@ -101,7 +107,7 @@ def robot_figure(sol: Solution, title: str | None = None):
     ax = fig.add_subplot(projection="3d")
     pts = draw_robot(ax, sol.chain, sol.raw.Q[0], sol.problem.toolpath.points_W)
     if sol.problem.cell is not None:
-        pts = np.vstack([pts, draw_cell(ax, sol, sol.raw.Q[0])])
+        pts = np.vstack([pts, draw_cell(ax, sol, sol.raw.Q[0], pts)])
     _equal_3d(ax, np.vstack([pts, np.zeros((1, 3))]))
     _label_axes(ax)
     ax.set_title(title or f"{sol.problem.chain.structure}: design cost {sol.metrics.design_cost:.3g} (start pose)")
@@ -174,8 +180,9 @@ def force_deflection_figure(sol: Solution):
     a0.set_ylabel("|force| on the tool [N]")
     a1.set_ylabel("tool deflection [um]")
     a1.set_xlabel(f"task time t [{unit}]")
-    a0.set_title(f"Force components and the deflection each causes ({sol.problem.stiffness.describe()[:60]})",
-                 fontsize=8)
+    stiffness = sol.problem.stiffness
+    model = stiffness.name or ("K = I" if stiffness.is_paper_model else "stated stiffness")
+    a0.set_title(f"Force components and the tool deflection each causes (stiffness: {model})", fontsize=9)
     for ax in (a0, a1):
         ax.legend(fontsize=7, ncol=4)
     fig.tight_layout()
@@ -206,7 +213,7 @@ def render_figure(sol: Solution, frames: int = 6):
                                 color=cmap(0.35 + 0.65 * n / max(frames - 1, 1)),
                                 label=f"t = {t[k]:.2f}"))
     if sol.problem.cell is not None:
-        drawn.append(draw_cell(ax, sol, Q[0]))
+        drawn.append(draw_cell(ax, sol, Q[0], np.vstack(drawn)))
     _equal_3d(ax, np.vstack(drawn + [np.zeros((1, 3))]))
     _label_axes(ax)
     ax.set_title(f"{chain.structure} ({sol.method}): design cost {sol.metrics.design_cost:.3g}")

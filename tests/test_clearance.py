@@ -4,6 +4,7 @@ through the workpiece block."""
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import coal
 import numpy as np
@@ -127,3 +128,33 @@ def test_per_joint_stiffness_reaches_the_deflection(tmp_path):
     bad = parse_config({"robot": {"stiffness": [1.0, 2.0]}}, tmp_path / "c.yaml")
     with pytest.raises(Exception, match="robot.stiffness: the list has 2 values but the robot has 6 moving joints"):
         problem_from_config(bad)
+
+
+def test_the_production_job_end_to_end(tmp_path):
+    """configs/gcode_pocket.yaml, coarser (one start, 6 mm spacing): G-code in, a placement that tracks every
+    cutting move and keeps the clearance (coal), re-verified from the file, the cell exported as URDF."""
+    import json
+    import shutil
+
+    import yaml
+    import yourdfpy
+
+    root = Path(__file__).resolve().parents[1] / "configs"
+    shutil.copy(root / "pocket.nc", tmp_path / "pocket.nc")
+    cfg = yaml.safe_load((root / "gcode_pocket.yaml").read_text())
+    cfg["toolpath"]["spacing"] = 0.006
+    cfg["solver"].update(multistart=1, jobs=1)
+    (tmp_path / "pocket.yaml").write_text(yaml.safe_dump(cfg))
+    result = CliRunner().invoke(app, ["run", str(tmp_path / "pocket.yaml"), "--out", str(tmp_path / "r"),
+                                      "--name", "t", "--urdf"])
+    assert result.exit_code == 0, result.output
+    run = tmp_path / "r" / "gcode_pocket" / "t"
+    data = json.loads((run / "best.json").read_text())
+    assert data["metrics"]["tracks"] and problems(data) == []
+    tracked = np.array(data["toolpath"]["tracked"])
+    assert tracked.any() and not tracked.all()  # cuts and rapids
+    value, _, _ = coal_clearance(data)
+    assert value >= cfg["cell"]["clearance"] - 1e-6
+    assert (run / "figures" / "force_deflection.png").exists()
+    urdf = yourdfpy.URDF.load(str(run / "export" / "best.urdf"), load_meshes=False)
+    assert {"floor", "workpiece", "tool"} <= set(urdf.link_map)
