@@ -22,7 +22,8 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # The tests that guard the objective; each mutation runs them with -x (stop at the first failure).
 TESTS = ["tests/test_objective_truth.py", "tests/test_costs_and_toolpaths.py", "tests/test_kinematics.py",
-         "tests/test_collocation.py", "tests/test_fk.py", "tests/test_cli_and_files.py", "tests/test_urdf.py"]
+         "tests/test_collocation.py", "tests/test_fk.py", "tests/test_cli_and_files.py", "tests/test_urdf.py",
+         "tests/test_gcode.py", "tests/test_forces.py", "tests/test_clearance.py"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +72,25 @@ MUTATIONS = [
              "[c + x * x * v, x * y * v + z * s, x * z * v + y * s, 0],"),
     Mutation("smoothness integral off by the interval length", "designopt/transcriptions/collocation.py",
              "return h / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)", "return 1 / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)"),
+    Mutation("G2 and G3 swapped", "designopt/gcode.py",
+             "period = -2 * math.pi if clockwise else 2 * math.pi",
+             "period = 2 * math.pi if clockwise else -2 * math.pi"),
+    Mutation("G20 read as millimetres", "designopt/gcode.py",
+             "UNITS = {20: 0.0254, 21: 0.001}", "UNITS = {20: 0.001, 21: 0.001}"),
+    Mutation("rapids count in the tracking error", "designopt/evaluation.py",
+             "max_pos, max_axis = float(pos_err[tracked].max()), float(axis_err[tracked].max())",
+             "max_pos, max_axis = float(pos_err.max()), float(axis_err.max())"),
+    Mutation("uneven time steps averaged in the integrals", "designopt/toolpaths.py",
+             "return np.concatenate([h, h[-1:]])", "return np.full(self.n, h.mean())"),
+    Mutation("feed-normal milling force mirrored", "designopt/forces.py",
+             "F_y = F_t * np.sin(phi) - F_r * np.cos(phi)", "F_y = -F_t * np.sin(phi) - F_r * np.cos(phi)"),
+    Mutation("Kienzle exponent dropped", "designopt/forces.py",
+             "h_mm ** (1.0 - m.mc)", "h_mm"),
+    Mutation("capsule radius left out of the block clearance", "designopt/clearance.py",
+             "need = cell.radius(link) + cell.clearance + length / (2 * (n - 1))",
+             "need = cell.clearance + length / (2 * (n - 1))"),
+    Mutation("per-joint stiffness read in reverse", "designopt/costs.py",
+             "return np.array(self.per_joint, dtype=float)", "return np.array(self.per_joint[::-1], dtype=float)"),
 ]
 
 
