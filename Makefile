@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup run test test-slow mutate lint figures benchmark clean
+.PHONY: setup run test test-slow mutate lint figures benchmark clean view-check
 
 setup: $(STAMP)
 
@@ -27,6 +27,12 @@ test-slow: setup
 # Plausible bugs applied one at a time in a temporary copy; every one must make a test fail.
 mutate: setup
 	$(BIN)/python tests/mutate.py
+
+# The interactive view in a real browser: Debian's headless Chromium screenshots the first and last frame of
+# the main job's view.html (apt-get install chromium first). Not part of `make test`.
+view-check: setup
+	$(BIN)/designopt run configs/milling.yaml --name view-check --out /tmp/designopt-view-check --resume
+	$(BIN)/python benchmarks/view_screenshot.py /tmp/designopt-view-check/milling/view-check/view.html --out docs/figures
 
 lint: setup
 	$(BIN)/ruff check .

@@ -350,6 +350,23 @@ def render(
         out.print(f"wrote {render_animation(sol, target / f'{solution.stem}_render.gif')}")
 
 
+@app.command()
+@user_errors
+def view(
+    solution: Annotated[Path, typer.Argument(help="A solution file (designopt.solution/1).")],
+    out_file: Annotated[Path | None, typer.Option("--out", help="HTML file (default: <solution>_view.html next "
+                                                                "to it).")] = None,
+    frames: Annotated[int, typer.Option(min=2, max=400, help="Robot poses in the animation.")] = 60,
+):
+    """Write an interactive 3D view of the cell: one self-contained HTML file (opens offline in any browser)."""
+    from designopt.solution import Solution
+    from designopt.view import write_view
+
+    sol = Solution.from_file(solution)
+    path = write_view(sol, out_file or solution.with_name(f"{solution.stem}_view.html"), frames)
+    out.print(f"wrote {path} (open it in a browser: no network needed)")
+
+
 def main() -> None:
     try:
         app()

@@ -4,19 +4,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from designopt.kinematics.chain import link_frames, placement_pose, tool_pose  # noqa: E402
-from designopt.solution import Solution  # noqa: E402
-
-plt.rcParams.update({"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "savefig.dpi": 200})
+from designopt import style
+from designopt.kinematics.chain import link_frames, placement_pose, tool_pose
+from designopt.solution import Solution
+from designopt.style import COLORS, fit_3d, label_3d, plt
 
 
 def save(fig, directory: Path, stem: str) -> list[Path]:
+    """Write the figure as PNG and PDF (the shared style crops to the drawn content) and close it."""
+    style.apply()
     directory.mkdir(parents=True, exist_ok=True)
     paths = [directory / f"{stem}.png", directory / f"{stem}.pdf"]
     for p in paths:
@@ -25,31 +23,24 @@ def save(fig, directory: Path, stem: str) -> list[Path]:
     return paths
 
 
-def _equal_3d(ax, points: np.ndarray) -> None:
-    centre = points.mean(axis=0)
-    radius = max(np.ptp(points, axis=0).max() / 2, 0.05)
-    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=True):
-        setter(c - radius, c + radius)
-    ax.set_box_aspect((1, 1, 1))
-
-
-def draw_robot(ax, chain, q: np.ndarray, points_W: np.ndarray | None = None, color: str = "C0",
-               label: str | None = None) -> np.ndarray:
+def draw_robot(ax, chain, q: np.ndarray, points_W: np.ndarray | None = None, color: str = COLORS["robot"],
+               label: str | None = None, alpha: float = 1.0) -> np.ndarray:
     """Draw a solved chain at joint values q (a polyline through the DH frame origins), its base and,
     if given, the toolpath placed in B. Returns the points drawn (for axis limits)."""
     frames = link_frames(chain, q, np.zeros(0))
     tool = tool_pose(chain, q, np.zeros(0))
     origins = np.array([T[:3, 3] for T in frames] + [tool[:3, 3]])
-    ax.plot(*origins.T, "-o", color=color, lw=3, ms=4, label=label or f"{chain.structure} robot")
-    ax.scatter(0, 0, 0, marker="s", s=60, color="k", label="base B" if label is None else None)
+    ax.plot(*origins.T, "-o", color=color, lw=3, ms=4, alpha=alpha, label=label or f"{chain.structure} robot")
+    ax.scatter(0, 0, 0, marker="s", s=40, color=COLORS["base"], label="base B" if label is None else None)
     drawn = [origins]
     if points_W is not None:
         T_BW = placement_pose(chain, q, np.zeros(0))
         s_B = (T_BW[:3, :3] @ np.asarray(points_W).T).T + T_BW[:3, 3]
         drawn.append(draw_workpiece(ax, T_BW, np.asarray(points_W), show_label=label is None))
-        ax.plot(*s_B.T, "-", color="C3", lw=1.5, label="toolpath (placed)" if label is None else None)
-        for axis, c in zip(range(3), ("r", "g", "b"), strict=True):
-            end = T_BW[:3, 3] + 0.1 * T_BW[:3, axis]
+        ax.plot(*s_B.T, "-", color=COLORS["path"], lw=1.5, label="toolpath (placed)" if label is None else None)
+        scale = 0.25 * max(float(np.ptp(s_B, axis=0).max()), 0.02)  # the W triad, sized to the path
+        for axis, c in zip(range(3), style.AXIS_COLORS, strict=True):
+            end = T_BW[:3, 3] + scale * T_BW[:3, axis]
             ax.plot(*np.c_[T_BW[:3, 3], end], color=c, lw=1)
         drawn.append(s_B)
     return np.vstack(drawn)
@@ -63,7 +54,7 @@ def draw_workpiece(ax, T_BW: np.ndarray, points_W: np.ndarray, margin: float = 0
     lo, hi = points_W[:, :2].min(axis=0) - margin, points_W[:, :2].max(axis=0) + margin
     corners_W = np.array([[lo[0], lo[1], 0], [hi[0], lo[1], 0], [hi[0], hi[1], 0], [lo[0], hi[1], 0]])
     corners_B = corners_W @ T_BW[:3, :3].T + T_BW[:3, 3]
-    ax.add_collection3d(Poly3DCollection([corners_B], facecolor="0.6", edgecolor="0.4", alpha=0.25,
+    ax.add_collection3d(Poly3DCollection([corners_B], facecolor=COLORS["workpiece"], edgecolor="0.4", alpha=0.25,
                                          label="workpiece top face" if show_label else None))
     return corners_B
 
@@ -82,7 +73,7 @@ def draw_cell(ax, sol: Solution, q: np.ndarray, robot_points: np.ndarray | None 
     c = corners_W @ T_BW[:3, :3].T + T_BW[:3, 3]
     faces = [[c[0], c[1], c[3], c[2]], [c[4], c[5], c[7], c[6]], [c[0], c[1], c[5], c[4]],
              [c[2], c[3], c[7], c[6]], [c[0], c[2], c[6], c[4]], [c[1], c[3], c[7], c[5]]]
-    ax.add_collection3d(Poly3DCollection(faces, facecolor="0.55", edgecolor="0.3", alpha=0.35,
+    ax.add_collection3d(Poly3DCollection(faces, facecolor=COLORS["workpiece"], edgecolor="0.3", alpha=0.35,
                                          label="workpiece block"))
     drawn = c if robot_points is None else np.vstack([c, robot_points, np.zeros((1, 3))])
     height = np.ptp(drawn[:, 2])
@@ -92,26 +83,37 @@ def draw_cell(ax, sol: Solution, q: np.ndarray, robot_points: np.ndarray | None 
     reach = np.abs(drawn[:, :2]).max() * 1.15
     floor = np.array([[-reach, -reach], [reach, -reach], [reach, reach], [-reach, reach]])
     floor = np.column_stack([floor, np.full(4, cell.floor)])
-    ax.add_collection3d(Poly3DCollection([floor], facecolor="tan", edgecolor="0.5", alpha=0.2, label="floor"))
+    ax.add_collection3d(Poly3DCollection([floor], facecolor=COLORS["floor"], edgecolor="0.5", alpha=0.25,
+                                         label="floor"))
     return np.vstack([c, floor])
 
 
-def _label_axes(ax) -> None:
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
+def draw_poses(ax, sol: Solution, poses: int = 5) -> np.ndarray:
+    """The solved robot at ``poses`` waypoints spread along its path (lighter = earlier), the placed path and
+    workpiece (the cell's block and floor when it has one). Returns every point drawn, for `fit_3d`."""
+    Q, pts = sol.raw.Q, sol.problem.toolpath.points_W
+    picks = np.unique(np.linspace(0, len(Q) - 1, poses).round().astype(int))
+    drawn = []
+    for n, k in enumerate(picks):
+        last = n == len(picks) - 1
+        alpha = 0.25 + 0.75 * n / max(len(picks) - 1, 1)
+        drawn.append(draw_robot(ax, sol.chain, Q[k], pts if last else None, color=COLORS["robot"],
+                                label=None if last else "_earlier pose", alpha=alpha))
+    if sol.problem.cell is not None:
+        drawn.append(draw_cell(ax, sol, Q[0], np.vstack(drawn)))
+    return np.vstack([*drawn, np.zeros((1, 3))])
 
 
 def robot_figure(sol: Solution, title: str | None = None):
-    fig = plt.figure(figsize=(5.5, 5))
+    """The designed cell in 3D: the robot at five poses along its path, the placed path and workpiece, equal
+    axes fitted to all of it, the legend under the axes."""
+    fig = plt.figure(figsize=(style.SINGLE * 1.5, style.SINGLE * 1.6))
     ax = fig.add_subplot(projection="3d")
-    pts = draw_robot(ax, sol.chain, sol.raw.Q[0], sol.problem.toolpath.points_W)
-    if sol.problem.cell is not None:
-        pts = np.vstack([pts, draw_cell(ax, sol, sol.raw.Q[0], pts)])
-    _equal_3d(ax, np.vstack([pts, np.zeros((1, 3))]))
-    _label_axes(ax)
-    ax.set_title(title or f"{sol.problem.chain.structure}: design cost {sol.metrics.design_cost:.3g} (start pose)")
-    ax.legend(loc="upper left", fontsize=7)
+    fit_3d(ax, draw_poses(ax, sol))
+    label_3d(ax)
+    ax.set_title(title or f"{sol.problem.chain.structure} robot at 5 poses along the path\n"
+                          f"design cost {sol.metrics.design_cost:.3g}")
+    style.legend_below(fig, ax)
     return fig
 
 
@@ -214,8 +216,8 @@ def render_figure(sol: Solution, frames: int = 6):
                                 label=f"t = {t[k]:.2f}"))
     if sol.problem.cell is not None:
         drawn.append(draw_cell(ax, sol, Q[0], np.vstack(drawn)))
-    _equal_3d(ax, np.vstack(drawn + [np.zeros((1, 3))]))
-    _label_axes(ax)
+    fit_3d(ax, np.vstack(drawn + [np.zeros((1, 3))]))
+    label_3d(ax)
     ax.set_title(f"{chain.structure} ({sol.method}): design cost {sol.metrics.design_cost:.3g}")
     ax.legend(loc="upper left", fontsize=6)
     return fig
@@ -236,8 +238,8 @@ def render_animation(sol: Solution, path: Path, fps: int = 15) -> Path:
         ax.cla()
         draw_robot(ax, chain, Q[k], pts)
         ax.scatter(*s_B[k], color="C3", s=25)
-        _equal_3d(ax, limits)
-        _label_axes(ax)
+        fit_3d(ax, limits)
+        label_3d(ax)
         ax.set_title(f"t = {t[k]:.2f}")
 
     anim = FuncAnimation(fig, frame, frames=len(Q))

@@ -7,7 +7,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from designopt.plots import _equal_3d, _label_axes, draw_robot, plt, save
+from designopt import style
+from designopt.plots import draw_poses, plt, save
+from designopt.style import METHOD_COLORS, fit_3d, label_3d
 
 METHOD_LABELS = {"to": "TO (collocation)", "fk": "FK (Whitman et al.)", "fk_continuous": "FK, bounded steps"}
 CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
@@ -28,7 +30,8 @@ def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Pa
                 ax.text(x, 1, "no start\ntracks", ha="center", fontsize=6)
                 continue
             cost = row["design_cost"].iloc[0]
-            ax.bar(x, cost, width * 0.9, color=f"C{j}", label=METHOD_LABELS[method] if i == 0 else None)
+            ax.bar(x, cost, width * 0.9, color=METHOD_COLORS.get(method, f"C{j}"),
+                   label=METHOD_LABELS[method] if i == 0 else None)
             starts = summary[(summary["case"] == case) & (summary["method"] == method) & summary["tracks"]]
             ax.scatter(np.full(len(starts), x), starts["design_cost"], s=8, color="k", zorder=3,
                        label="every tracking start" if (i == 0 and j == 0) else None)
@@ -49,16 +52,18 @@ def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Pa
 
 
 def optimal_robots_figure(solutions: dict, directory: Path) -> list[Path]:
-    """The best TO robots at theta = 0 (d = 0 for P joints) with the placed toolpath, side by side."""
-    fig = plt.figure(figsize=(4.5 * len(solutions), 4.5))
+    """The best TO robot of each case at five poses along its path with the placed toolpath, side by side; each
+    view has equal axes fitted to its own cell."""
+    fig = plt.figure(figsize=(style.DOUBLE, style.DOUBLE / max(len(solutions), 1) * 1.25))
+    ax = None
     for k, (case, sol) in enumerate(solutions.items()):
         ax = fig.add_subplot(1, len(solutions), k + 1, projection="3d")
-        pts = draw_robot(ax, sol.chain, np.zeros(sol.problem.chain.n_moving), sol.problem.toolpath.points_W)
-        _equal_3d(ax, np.vstack([pts, np.zeros((1, 3))]))
-        _label_axes(ax)
-        ax.set_title(f"{CASE_LABELS.get(case, case)}\ndesign cost {sol.metrics.design_cost:.3g}", fontsize=9)
-        if k == 0:
-            ax.legend(loc="upper left", fontsize=6)
+        fit_3d(ax, draw_poses(ax, sol))
+        label_3d(ax)
+        ax.set_title(f"{CASE_LABELS.get(case, case)}\ndesign cost {sol.metrics.design_cost:.3g}")
+    if ax is not None:
+        style.legend_below(fig, ax, ncol=4)
+    fig.subplots_adjust(wspace=0.15)
     return save(fig, directory, "optimal_robots")
 
 
@@ -84,23 +89,36 @@ def waypoint_figure(table: pd.DataFrame, directory: Path) -> list[Path]:
     return save(fig, directory, "waypoints")
 
 
-def _ranked_bars(ax, rows: pd.DataFrame, title: str) -> None:
+def _ranked_bars(ax, rows: pd.DataFrame, title: str, starts: pd.DataFrame | None = None) -> None:
+    """Structures ranked by their best design cost (bars) with every tracking start as a dot: the spread
+    over starts shows how much of a ranking is the search's luck."""
     rows = rows.sort_values("design_cost")
-    colors = ["C2" if np.isfinite(c) else "lightgrey" for c in rows["design_cost"]]
-    ax.bar(range(len(rows)), rows["design_cost"].fillna(0), color=colors)
+    colors = [style.COLORS["best"] if np.isfinite(c) else "lightgrey" for c in rows["design_cost"]]
+    ax.bar(range(len(rows)), rows["design_cost"].fillna(0), color=colors, label="best tracking start")
+    if starts is not None and len(starts):
+        for i, structure in enumerate(rows["structure"]):
+            costs = starts.loc[(starts["structure"] == structure) & starts["tracks"], "design_cost"]
+            ax.scatter(np.full(len(costs), i), costs, s=6, color=style.COLORS["start"], zorder=3,
+                       label="every tracking start" if i == 0 else None)
+        ax.legend(fontsize=6)
     ax.set_xticks(range(len(rows)), rows["structure"], rotation=90, fontsize=7, family="monospace")
     ax.set_yscale("log")
-    ax.set_ylabel("design cost (best tracking start)")
+    ax.set_ylabel("design cost")
     ax.set_title(title, fontsize=9)
 
 
-def structure_figures(table: pd.DataFrame, directory: Path) -> list[Path]:
-    """The paper's structure figures plus best cost per number of joints."""
+def structure_figures(table: pd.DataFrame, directory: Path, summary: pd.DataFrame | None = None) -> list[Path]:
+    """The paper's structure figures plus best cost per number of joints; with the sweep's summary, every
+    start is shown beside each structure's best."""
     paths = []
     six = table[table["dof"] == 6]
     if len(six):
         fig, ax = plt.subplots(figsize=(6, 3.5))
-        ax.scatter(six["n_prismatic"], six["design_cost"], s=14, alpha=0.6, label="each 6-DOF structure")
+        if summary is not None:
+            every = summary[(summary["dof"] == 6) & summary["tracks"]]
+            ax.scatter(every["n_prismatic"] + 0.12, every["design_cost"], s=4, color=style.COLORS["other"],
+                       label="every tracking start")
+        ax.scatter(six["n_prismatic"], six["design_cost"], s=14, alpha=0.6, label="each 6-DOF structure (best)")
         best = six.groupby("n_prismatic")["design_cost"].min()
         ax.plot(best.index, best.values, "o-", color="C3", label="best per number of P joints")
         ax.set_yscale("log")
@@ -113,7 +131,7 @@ def structure_figures(table: pd.DataFrame, directory: Path) -> list[Path]:
         rows = table[(table["dof"] == dof) & (table["n_prismatic"] == 3)]
         if len(rows):
             fig, ax = plt.subplots(figsize=(max(4, 0.3 * len(rows) + 1.5), 3.5))
-            _ranked_bars(ax, rows, f"{dof}-DOF structures with three prismatic joints, ranked")
+            _ranked_bars(ax, rows, f"{dof}-DOF structures with three prismatic joints, ranked", summary)
             paths += save(fig, directory, stem)
     if len(table):
         from designopt.tables import best_per_dof

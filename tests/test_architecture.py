@@ -17,7 +17,8 @@ LAYERS = [
     ("designopt.problem",),
     ("designopt.transcriptions", "designopt.initial_guess"),
     ("designopt.evaluation", "designopt.solution", "designopt.results_io", "designopt.multistart"),
-    ("designopt.tables", "designopt.plots", "designopt.plots_experiments", "designopt.export"),
+    ("designopt.tables", "designopt.style", "designopt.plots", "designopt.plots_experiments", "designopt.export",
+     "designopt.view"),
     ("designopt.experiments",),
     ("cli",),
 ]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 
 import pandas as pd
 import pytest
@@ -36,6 +37,9 @@ def test_run_writes_the_run_directory(finished_run):
     for stem in ("robot", "joints", "deformation"):
         assert (run / "figures" / f"{stem}.png").stat().st_size > 1000
         assert (run / "figures" / f"{stem}.pdf").is_file()
+    view = (run / "view.html").read_text()
+    assert "Plotly.newPlot" in view and "Plotly.addFrames" in view  # animated, plotly.js inside
+    assert not re.search(r"<script[^>]+src=[\"']https?://", view)  # nothing to fetch: opens offline
     summary = pd.read_csv(run / "summary.csv")
     assert len(summary) == 2
     required = ["experiment", "case", "method", "structure", "dof", "n_prismatic", "design_cost",
@@ -44,6 +48,16 @@ def test_run_writes_the_run_directory(finished_run):
     assert set(required) <= set(summary.columns)
     assert summary["best"].sum() == 1
     assert (summary["stiffness_revolute"] == 1.0).all()
+
+
+def test_view_command_writes_one_offline_file(finished_run, tmp_path):
+    _, run = finished_run
+    result = runner.invoke(app, ["view", str(run / "best.json"), "--out", str(tmp_path / "v.html"), "--frames", "5"])
+    assert result.exit_code == 0, result.output
+    html = (tmp_path / "v.html").read_text()
+    assert html.count('"name":"') >= 5 and "sliders" in html
+    bad = runner.invoke(app, ["view", str(tmp_path / "missing.json")])
+    assert bad.exit_code == 2 and len(bad.output.strip().splitlines()) == 1
 
 
 def test_piped_output_is_not_cut(finished_run):

@@ -52,8 +52,10 @@ def run_experiment(cfg: Config, base_dir: Path, out_root: Path, run_name: str | 
                 f"optima among {len(solutions)} solves")
         if figures:
             from designopt import plots
+            from designopt.view import write_view
 
             plots.solution_figures(best, run.figures)
+            write_view(best, run.path / "view.html")
     else:
         run.log("no start tracks the path")
     return RunResult(run, solutions, best, summary, optima)

@@ -103,12 +103,13 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
         with backend(backend_name, scheduler, jobs):
             # the plan already left out finished solves; their rows stay, and the table reads them
             solve_tasks(run, sweep_plan.tasks, cfg.name, jobs=None, progress=_Solved(progress))
-    table = structure_table(pd.read_csv(run.summary))
+    summary = pd.read_csv(run.summary)
+    table = structure_table(summary)
     table.to_csv(run.path / "table.csv", index=False)
     if figures:
         from designopt import plots_experiments
 
-        plots_experiments.structure_figures(table, run.figures)
+        plots_experiments.structure_figures(table, run.figures, summary)
     run.log("done")
     return SweepResult(run, table, best_per_dof(table), len(structures), len(sweep_plan.tasks), sweep_plan.skipped)
 
