@@ -1,6 +1,6 @@
 """Open a designopt view.html in headless Chromium (Debian's package) and save screenshots: the first frame and
-the middle one (view.html#frame=N; a closed path ends where it starts), with the network disabled, so that a person can look at them and the script
-can check that the page rendered and that the animation frames move the robot.
+the middle one (view.html#frame=N; a closed path ends where it starts), with the network disabled, so that a
+person can look at them and the script can check that the page rendered and that the frames move the robot.
 
     python benchmarks/view_screenshot.py results/milling/<run>/view.html [--out docs/figures]
 

@@ -54,7 +54,7 @@ def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Pa
 def optimal_robots_figure(solutions: dict, directory: Path) -> list[Path]:
     """The best TO robot of each case at five poses along its path with the placed toolpath, side by side; each
     view has equal axes fitted to its own cell."""
-    fig = plt.figure(figsize=(style.DOUBLE, style.DOUBLE / max(len(solutions), 1) * 1.25))
+    fig = plt.figure(figsize=(style.DOUBLE, style.DOUBLE / max(len(solutions), 1) * 1.05))
     ax = None
     for k, (case, sol) in enumerate(solutions.items()):
         ax = fig.add_subplot(1, len(solutions), k + 1, projection="3d")
@@ -63,7 +63,7 @@ def optimal_robots_figure(solutions: dict, directory: Path) -> list[Path]:
         ax.set_title(f"{CASE_LABELS.get(case, case)}\ndesign cost {sol.metrics.design_cost:.3g}")
     if ax is not None:
         style.legend_below(fig, ax, ncol=4)
-    fig.subplots_adjust(wspace=0.15)
+    fig.subplots_adjust(wspace=0.35)
     return save(fig, directory, "optimal_robots")
 
 
@@ -138,13 +138,24 @@ def structure_figures(table: pd.DataFrame, directory: Path, summary: pd.DataFram
 
         best = best_per_dof(table)
         fig, ax = plt.subplots(figsize=(5, 3.2))
-        ax.semilogy(best["dof"], best["design_cost"], "o-")
+        if summary is not None:
+            every = summary[summary["tracks"]]
+            ax.scatter(every["dof"] + 0.08, every["design_cost"], s=3, color=style.COLORS["other"],
+                       label="every tracking start")
+        ax.semilogy(best["dof"], best["design_cost"], "o-", color=style.COLORS["robot"], label="best structure")
         for _, r in best.iterrows():
-            ax.annotate(r["structure"], (r["dof"], r["design_cost"]), textcoords="offset points", xytext=(4, 4),
-                        fontsize=7, family="monospace")
+            ax.annotate(r["structure"], (r["dof"], r["design_cost"]), textcoords="offset points", xytext=(-6, 6),
+                        ha="right", fontsize=7, family="monospace")
+        from matplotlib.ticker import LogLocator, NullFormatter
+
+        ax.set_xticks(sorted(best["dof"].unique()))
+        ax.set_xlim(best["dof"].min() - 0.5, best["dof"].max() + 0.5)
+        ax.yaxis.set_major_locator(LogLocator(numticks=6))
+        ax.yaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("number of joints")
-        ax.set_ylabel("best design cost")
+        ax.set_ylabel("design cost")
         ax.set_title("Best structure per number of joints", fontsize=9)
+        ax.legend(fontsize=7)
         paths += save(fig, directory, "structures_best_per_dof")
     return paths
 

@@ -62,7 +62,7 @@ def fit_3d(ax, points: np.ndarray, margin: float = 0.06, minimum: float = 0.05) 
     half = np.maximum((hi - lo) / 2 + pad, minimum / 2)
     for setter, c, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, half, strict=True):
         setter(c - h, c + h)
-    ax.set_box_aspect(tuple(2 * half), zoom=0.9)
+    ax.set_box_aspect(tuple(2 * half), zoom=0.85)
 
 
 def label_3d(ax) -> None:
