@@ -222,6 +222,7 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
     check_start_values(cfg, chain)
     toolpath = toolpath_from_config(cfg, base_dir)
     check_standoff(cfg, chain, toolpath)
+    check_on_block(cfg, cell, toolpath)
     return DesignProblem(
         name=cfg.name,
         chain=chain,
@@ -241,6 +242,20 @@ def problem_from_config(cfg: Config, base_dir: Path = Path(".")) -> DesignProble
         axis_tol=cfg.tolerance.axis,
         cell=cell,
     )
+
+
+def check_on_block(cfg: Config, cell: Cell | None, toolpath: toolpaths.Toolpath) -> None:
+    """Every cutting waypoint lies over the block's top face (the tool cuts the block, not the air beside it)."""
+    if cell is None:
+        return
+    (sx, sy, _), (cx, cy) = cell.block_size, cell.block_center
+    xy = toolpath.points_W[toolpath.is_tracked, :2]
+    outside = np.flatnonzero((np.abs(xy[:, 0] - cx) > sx / 2 + 1e-9) | (np.abs(xy[:, 1] - cy) > sy / 2 + 1e-9))
+    if len(outside):
+        x, y = xy[outside[0]]
+        span = f"x {cx - sx / 2:.4g}..{cx + sx / 2:.4g}, y {cy - sy / 2:.4g}..{cy + sy / 2:.4g}"
+        raise cfg.error("cell.block", f"{len(outside)} cutting waypoints lie beside the block's top face (the first at "
+                                      f"x = {x:.4g}, y = {y:.4g} m in W; the face spans {span}): move or grow it")
 
 
 def with_tool_length(chain: Chain, length: float) -> Chain:

@@ -73,7 +73,7 @@ class Solution:
         tol = m.get("tolerances", {})
         limits = data.get("joint_limits") or [{}]
         problem = DesignProblem(name=data.get("method", "file"), chain=chain, toolpath=toolpath,
-                                stiffness=Stiffness(per_joint=tuple(float(v) for v in data["stiffness"])),
+                                stiffness=_stiffness_from_file(data),
                                 deflection=m["deflection"],
                                 position_tol=tol.get("position", 1e-3), axis_tol=tol.get("axis", 1e-2),
                                 joint_velocity=float(limits[0].get("velocity_per_task_time", 10.0)),
@@ -149,6 +149,18 @@ def robot_description(chain: Chain) -> dict:
     return {"ets": [{"motion": et.motion, "axis": list(et.axis),
                      "value": None if chain.joints[et.joint].role is Role.MOVING else float(values[et.joint])}
                     for et in chain.robot]}
+
+
+def _stiffness_from_file(data: dict) -> Stiffness:
+    """The stiffness model a file states: the two-value model when it names one, else one value per joint."""
+    model = data["metrics"].get("stiffness_model") or {}
+    revolute, prismatic = model.get("revolute_Nm_per_rad"), model.get("prismatic_N_per_m")
+    per_joint = tuple(float(v) for v in data["stiffness"])
+    if revolute is not None and prismatic is not None:
+        two = Stiffness(float(revolute), float(prismatic))
+        if np.allclose(two.diagonal(data["structure"]), per_joint, rtol=0, atol=0):
+            return two
+    return Stiffness(per_joint=per_joint)
 
 
 def cell_to_dict(cell: Cell) -> dict:

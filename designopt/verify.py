@@ -314,11 +314,7 @@ def recompute(data: dict, position_tol: float = 1e-3, axis_tol: float = 1e-2, de
     tol = data["metrics"].get("tolerances", {})
     position_tol, axis_tol = tol.get("position", position_tol), tol.get("axis", axis_tol)
     deflection = deflection or data["metrics"]["deflection"]
-    x, y, z = data["placement"]["xyz"]
-    yaw, pitch, roll = data["placement"]["ypr"]
-    T_BW = np.eye(4)
-    T_BW[:3, 3] = (x, y, z)
-    T_BW = T_BW @ _rot("z", yaw) @ _rot("y", pitch) @ _rot("x", roll)
+    T_BW = _placement(data)
     tool = np.array(data["tool"])
     k_inv = 1.0 / np.array(data["stiffness"])
     pts, forces, Q = np.array(data["toolpath"]["points_W"]), np.array(data["toolpath"]["force_W"]), np.array(data["q"])

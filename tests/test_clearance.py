@@ -158,3 +158,13 @@ def test_the_production_job_end_to_end(tmp_path):
     assert (run / "figures" / "force_deflection.png").exists()
     urdf = yourdfpy.URDF.load(str(run / "export" / "best.urdf"), load_meshes=False)
     assert {"floor", "workpiece", "tool"} <= set(urdf.link_map)
+
+
+def test_a_path_beside_the_block_is_a_config_error(tmp_path):
+    import yaml
+
+    cfg = {"toolpath": {"kind": "line", "length": 0.5}, "cell": {"block": {"size": [0.2, 0.1, 0.05]}}}
+    (tmp_path / "c.yaml").write_text(yaml.safe_dump(cfg))
+    result = CliRunner().invoke(app, ["check", str(tmp_path / "c.yaml")])
+    assert result.exit_code == 2 and len(result.output.strip().splitlines()) == 1
+    assert "cell.block" in result.output and "beside the block" in result.output
