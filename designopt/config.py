@@ -189,8 +189,8 @@ class SolverConfig(_Strict):
     degree: Literal[3] = 3
     multistart: Annotated[int, Field(ge=1, le=1000)] = 4
     seed: Annotated[int, Field(ge=0)] = 0
-    max_iter: Annotated[int, Field(ge=1)] = 3000
-    jobs: Annotated[int, Field(ge=-1)] = -1  # -1: every core; 0 is rejected in _semantic_errors
+    max_iter: Annotated[int, Field(ge=1, le=1_000_000)] = 3000  # IPOPT takes a 32-bit int
+    jobs: Annotated[int, Field(ge=-1, le=1024)] = -1  # -1: every core; 0 is rejected in _semantic_errors
     perturbation: Annotated[float, Field(ge=0)] = 0.3
     init: Literal["reach", "ik", "constant"] = "ik"
     compile: Literal["none", "O0", "O1", "O2"] = "O0"

@@ -51,6 +51,8 @@ BAD_INPUTS = [
     ("fixed placement inside stand-off", {"placement": {"keep_out_radius": 5.0}}, None,
      "placement.keep_out_radius", "inside the stand-off"),
     ("zero jobs", {"solver": {"jobs": 0}}, None, "solver.jobs", "0 workers"),
+    # found by the slow fuzz: IPOPT takes a 32-bit iteration limit (2^31 crashed it)
+    ("iteration cap beyond IPOPT's int", {"solver": {"max_iter": 2**31}}, None, "solver.max_iter", "less than"),
     ("too few waypoints", {"toolpath": {"kind": "line", "waypoints": 2}}, None, "toolpath.waypoints", "3"),
     ("zero-size path", {"toolpath": {"length": 1e-300}}, None, "toolpath", "zero speed"),
     ("module index beyond catalogue", {"modular": {"enumeration_modules": [9]}}, None,
