@@ -137,7 +137,13 @@ def structure_figures(table: pd.DataFrame, directory: Path, summary: pd.DataFram
         from designopt.tables import best_per_dof
 
         best = best_per_dof(table)
+        best = best[np.isfinite(best["design_cost"].astype(float))]
         fig, ax = plt.subplots(figsize=(5, 3.2))
+        if best.empty:  # no structure tracks: say so rather than draw empty log axes
+            ax.text(0.5, 0.5, "no structure tracks the path", ha="center", va="center", transform=ax.transAxes)
+            ax.set_axis_off()
+            paths += save(fig, directory, "structures_best_per_dof")
+            return paths
         if summary is not None:
             every = summary[summary["tracks"]]
             ax.scatter(every["dof"] + 0.08, every["design_cost"], s=3, color=style.COLORS["other"],
