@@ -79,14 +79,6 @@ def skeleton(chain: Chain, q_m, q_d, tool_length: float = 0.0) -> tuple[list, li
     return points, links
 
 
-def tool_axis_segment(chain: Chain, q_m, q_d, length: float):
-    """(start, end) of the tool cylinder's axis in B: from ``length`` behind the tool centre point to it."""
-    from designopt.kinematics.chain import tool_pose
-
-    T = tool_pose(chain, q_m, q_d)
-    return T[:3, 3] - length * T[:3, 2], T[:3, 3]
-
-
 def _box_frame(cell: Cell):
     """Centre (3) and half extents (3) of the block in W."""
     sx, sy, sz = cell.block_size

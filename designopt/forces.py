@@ -127,13 +127,3 @@ def milling_force_components(process: MillingProcess, tangents_W: np.ndarray) ->
     frames = feed_frames(tangents_W)
     mean = mean_force(process)
     return np.stack([mean[i] * frames[:, :, i] for i in range(3)])
-
-
-def milling_forces(process: MillingProcess, tangents_W: np.ndarray) -> np.ndarray:
-    """(N, 3) force on the tool in W at every waypoint, newtons."""
-    return milling_force_components(process, tangents_W).sum(axis=0)
-
-
-def paper_forces(alpha: float, tangents_W: np.ndarray) -> np.ndarray:
-    """SPEC §3: F = alpha * unit tangent."""
-    return alpha * np.asarray(tangents_W, dtype=float)
