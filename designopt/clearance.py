@@ -79,6 +79,17 @@ def skeleton(chain: Chain, q_m, q_d, tool_length: float = 0.0) -> tuple[list, li
     return points, links
 
 
+# The block's faces as corner indices of `block_corners_W`, each face's corners in order around it.
+BLOCK_FACES = ((0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4), (1, 3, 7, 5))
+
+
+def block_corners_W(cell: Cell) -> np.ndarray:
+    """The block's 8 corners in W (8 x 3), x varying fastest, then y, then z (bottom face first)."""
+    (sx, sy, sz), (cx, cy) = cell.block_size, cell.block_center
+    return np.array([[x, y, z] for z in (-sz, 0.0) for y in (cy - sy / 2, cy + sy / 2)
+                     for x in (cx - sx / 2, cx + sx / 2)])
+
+
 def _box_frame(cell: Cell):
     """Centre (3) and half extents (3) of the block in W."""
     sx, sy, sz = cell.block_size
@@ -131,13 +142,8 @@ def block_above_floor(chain: Chain, cell: Cell, q_d) -> list:
     """Expressions >= 0 when the block's four bottom corners are at or above the floor (a function of the design
     joints only: the placement)."""
     T_BW = placement_pose(chain, np.zeros(chain.n_moving), q_d)
-    centre, half = _box_frame(cell)
-    out = []
-    for sx in (-1, 1):
-        for sy in (-1, 1):
-            corner = centre + np.array([sx * half[0], sy * half[1], -half[2]])
-            out.append((T_BW[:3, :3] @ corner + T_BW[:3, 3])[2] - cell.floor)
-    return out
+    bottom = block_corners_W(cell)[[0, 2, 1, 3]]
+    return [(T_BW[:3, :3] @ corner + T_BW[:3, 3])[2] - cell.floor for corner in bottom]
 
 
 def segment_box_distance(a_W: np.ndarray, b_W: np.ndarray, cell: Cell, iterations: int = 80) -> float:

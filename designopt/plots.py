@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from designopt import style
+from designopt.clearance import BLOCK_FACES, block_corners_W
 from designopt.kinematics.chain import link_frames, placement_pose, tool_pose
 from designopt.solution import Solution
 from designopt.style import COLORS, fit_3d, label_3d, plt
@@ -14,7 +15,6 @@ from designopt.style import COLORS, fit_3d, label_3d, plt
 
 def save(fig, directory: Path, stem: str) -> list[Path]:
     """Write the figure as PNG and PDF (the shared style crops to the drawn content) and close it."""
-    style.apply()
     directory.mkdir(parents=True, exist_ok=True)
     paths = [directory / f"{stem}.png", directory / f"{stem}.pdf"]
     for p in paths:
@@ -67,12 +67,8 @@ def draw_cell(ax, sol: Solution, q: np.ndarray, robot_points: np.ndarray | None 
 
     cell = sol.problem.cell
     T_BW = placement_pose(sol.chain, q, np.zeros(0))
-    (sx, sy, sz), (cx, cy) = cell.block_size, cell.block_center
-    xs, ys, zs = (cx - sx / 2, cx + sx / 2), (cy - sy / 2, cy + sy / 2), (-sz, 0.0)
-    corners_W = np.array([[x, y, z] for z in zs for y in ys for x in xs])
-    c = corners_W @ T_BW[:3, :3].T + T_BW[:3, 3]
-    faces = [[c[0], c[1], c[3], c[2]], [c[4], c[5], c[7], c[6]], [c[0], c[1], c[5], c[4]],
-             [c[2], c[3], c[7], c[6]], [c[0], c[2], c[6], c[4]], [c[1], c[3], c[7], c[5]]]
+    c = block_corners_W(cell) @ T_BW[:3, :3].T + T_BW[:3, 3]
+    faces = [[c[i] for i in face] for face in BLOCK_FACES]
     ax.add_collection3d(Poly3DCollection(faces, facecolor=COLORS["workpiece"], edgecolor="0.3", alpha=0.35,
                                          label="workpiece block"))
     drawn = c if robot_points is None else np.vstack([c, robot_points, np.zeros((1, 3))])
@@ -153,21 +149,15 @@ def deformation_figure(sol: Solution):
 def deflection_by_component(sol: Solution) -> list[tuple[str, np.ndarray]]:
     """|delta_i| (m per the stiffness units) at every waypoint caused by each named part of the force alone:
     delta = J K^-1 J^T [f; 0] is linear in f, so the parts' deflections sum to the total (as vectors)."""
+    from designopt.costs import deflection
     from designopt.kinematics.chain import geometric_jacobian
 
     p, Q = sol.problem, sol.raw.Q
-    T_BW = placement_pose(sol.chain, Q[0], np.zeros(0))
-    k_inv = 1.0 / p.stiffness.diagonal(sol.chain.structure)
-    compliance = []
-    for q in Q:
-        J = geometric_jacobian(sol.chain, q, np.zeros(0))
-        compliance.append((J * k_inv) @ J.T)
-    out = []
-    for name, part in (*p.toolpath.force_parts, ("total", p.toolpath.force_W)):
-        f_B = part @ T_BW[:3, :3].T
-        delta = np.array([C[:3, :3] @ f for C, f in zip(compliance, f_B, strict=True)])
-        out.append((name, np.linalg.norm(delta, axis=1)))
-    return out
+    R_BW = placement_pose(sol.chain, Q[0], np.zeros(0))[:3, :3]
+    jacobians = [geometric_jacobian(sol.chain, q, np.zeros(0)) for q in Q]
+    return [(name, np.array([np.linalg.norm(deflection(J, p.k_inv, R_BW @ f)[:3])
+                             for J, f in zip(jacobians, part, strict=True)]))
+            for name, part in (*p.toolpath.force_parts, ("total", p.toolpath.force_W))]
 
 
 def force_deflection_figure(sol: Solution):

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import plotly.graph_objects as go
 
-from designopt.clearance import skeleton
+from designopt.clearance import BLOCK_FACES, block_corners_W, skeleton
 from designopt.kinematics.chain import placement_pose, tool_pose
 from designopt.solution import Solution
 from designopt.style import COLORS
@@ -80,9 +80,8 @@ def robot_mesh(sol: Solution, q: np.ndarray, radius: float) -> tuple[np.ndarray,
 
 
 def _box_mesh(corners: np.ndarray):
-    """Triangles of a box given its 8 corners ordered (x fastest, then y, then z)."""
-    faces = [(0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4), (1, 3, 7, 5)]
-    triangles = [t for a, b, c, d in faces for t in ((a, b, c), (a, c, d))]
+    """Triangles of a box given its 8 corners in the order of `block_corners_W`."""
+    triangles = [t for a, b, c, d in BLOCK_FACES for t in ((a, b, c), (a, c, d))]
     return corners, np.array(triangles)
 
 
@@ -102,9 +101,7 @@ def cell_figure(sol: Solution, frames: int = 60) -> go.Figure:
     traces = []
     cell = sol.problem.cell
     if cell is not None:
-        (sx, sy, sz), (cx, cy) = cell.block_size, cell.block_center
-        corners = np.array([[x, y, z] for z in (-sz, 0.0) for y in (cy - sy / 2, cy + sy / 2)
-                            for x in (cx - sx / 2, cx + sx / 2)])
+        corners = block_corners_W(cell)
         traces.append(_mesh_trace(*_box_mesh(corners @ T_BW[:3, :3].T + T_BW[:3, 3]), "#9aa0a6", "workpiece block",
                                   0.6))
         span = 1.2 * max(reach, float(np.abs(s_B[:, :2]).max()))
