@@ -99,12 +99,18 @@ def run(
     cfg = load(config)
     with Bar(f"{cfg.name}: solving") as bar:
         result = run_experiment(cfg, config.parent, out_dir, name, bar, figures=not no_figures, resume=resume)
-    problem = result.solutions[0].problem
+    problem = result.problem
+    if result.explored:
+        tracking = sum(s.metrics.tracks for s in result.explored)
+        out.print(f"explored: {len(result.explored)} starts on {result.explored[0].problem.toolpath.n} waypoints, "
+                  f"{tracking} track, {len(result.solution_set)} distinct optima; the best "
+                  f"{len(result.solutions)} refined on the full path ({problem.toolpath.n} waypoints)")
     show(solutions_table(result.solutions, f"{cfg.name}: {problem.chain.structure}, "
                                            f"stiffness {problem.stiffness.describe()}"))
     if len(result.solution_set):
         show(_frame_table(result.solution_set.head(8), f"distinct optima reached ({len(result.solution_set)} among "
-                                                       f"{len(result.solutions)} solves; solution_set.csv)"))
+                                                       f"{len(result.explored or result.solutions)} solves; "
+                                                       "solution_set.csv)"))
     if result.best is None:
         out.print("[yellow]No start tracks the path within tolerance; see summary.csv for statuses.[/yellow]")
     else:

@@ -182,6 +182,19 @@ class ToleranceConfig(_Strict):
     axis: Positive = 1.0e-2
 
 
+class SearchConfig(_Strict):
+    """How `designopt run` searches a problem (`designopt.search`): ``coarse_to_fine`` explores with many cheap
+    starts on a coarse sampling of the path and refines the best distinct optima on the full path;
+    ``multistart`` solves ``solver.multistart`` cold starts on the full path."""
+
+    strategy: Literal["coarse_to_fine", "multistart"] = "coarse_to_fine"
+    explore_waypoints: Annotated[int, Field(ge=3, le=5000)] = 10
+    explore_starts: Annotated[int, Field(ge=1, le=1000)] = 80
+    explore_max_iter: Annotated[int, Field(ge=1, le=1_000_000)] = 250
+    refine: Annotated[int, Field(ge=1, le=1000)] = 4
+    distinct: Annotated[float, Field(gt=0)] = 0.02  # m or rad
+
+
 class SolverConfig(_Strict):
     method: Literal["to"] = "to"
     kinematics: Literal["forward", "differential"] = "forward"
@@ -195,6 +208,7 @@ class SolverConfig(_Strict):
     init: Literal["reach", "ik", "constant"] = "ik"
     compile: Literal["none", "O0", "O1", "O2"] = "O0"
     time_limit: Positive = 300.0
+    search: SearchConfig = SearchConfig()
 
 
 Method = Literal["to", "fk", "fk_continuous"]

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from designopt.initial_guess import initial_guess
 from designopt.problem import DesignProblem
 from designopt.solution import Solution, solve_and_evaluate
+from designopt.transcriptions.base import InitialGuess
 
 # IPOPT's linear algebra gains nothing from threads at this size; parallelism is across starts.
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -40,12 +41,17 @@ def _built(key: str, payload: bytes):
     return transcription.build(problem)
 
 
-def solve_start(problem: DesignProblem, transcription, settings: Multistart, index: int, label: str = "") -> Solution:
-    """Build (or reuse) the NLP and solve start ``index`` of the multistart."""
+def solve_guess(problem: DesignProblem, transcription, guess: InitialGuess, label: str = "") -> Solution:
+    """Build (or reuse) the NLP and solve it from ``guess``."""
     payload = pickle.dumps((problem, transcription))
     nlp = _built(hashlib.sha256(payload).hexdigest(), payload)
-    guess = initial_guess(problem, index, settings.seed, settings.scale, settings.init)
     return solve_and_evaluate(problem, transcription.name, nlp.solve(guess), label)
+
+
+def solve_start(problem: DesignProblem, transcription, settings: Multistart, index: int, label: str = "") -> Solution:
+    """Build (or reuse) the NLP and solve start ``index`` of the multistart."""
+    guess = initial_guess(problem, index, settings.seed, settings.scale, settings.init)
+    return solve_guess(problem, transcription, guess, label)
 
 
 def best_solution(solutions) -> Solution | None:

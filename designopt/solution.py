@@ -81,6 +81,13 @@ class Solution:
         raw = _raw_from_file(data, np.zeros(0))
         return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, raw.Q, raw.V))
 
+    def _interval(self, t):
+        tk = self.problem.toolpath.t
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        k = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
+        h = (tk[k + 1] - tk[k])[:, None]
+        return k, h, (t[:, None] - tk[k][:, None]) / h
+
     def sample(self, t) -> np.ndarray:
         """Joint values q(t) (len(t) x n_m) at task times t in [0, 1].
 
@@ -88,16 +95,23 @@ class Solution:
         has joint velocities (TO's knots); without them (the FK baseline) it is the straight line, which is
         all that baseline defines.
         """
-        tk, Q, V = self.problem.toolpath.t, np.asarray(self.raw.Q, float), self.raw.V
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        k = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
-        h = (tk[k + 1] - tk[k])[:, None]
-        s = (t[:, None] - tk[k][:, None]) / h
+        Q, V = np.asarray(self.raw.Q, float), self.raw.V
+        k, h, s = self._interval(t)
         if V is None:
             return Q[k] + s * (Q[k + 1] - Q[k])
         V = np.asarray(V, float)
         return ((2 * s**3 - 3 * s**2 + 1) * Q[k] + (s**3 - 2 * s**2 + s) * h * V[k]
                 + (-2 * s**3 + 3 * s**2) * Q[k + 1] + (s**3 - s**2) * h * V[k + 1])
+
+    def sample_velocity(self, t) -> np.ndarray:
+        """Joint velocities dq/dt (len(t) x n_m, per unit of the path's time) of `sample`'s trajectory."""
+        Q, V = np.asarray(self.raw.Q, float), self.raw.V
+        k, h, s = self._interval(t)
+        if V is None:
+            return (Q[k + 1] - Q[k]) / h
+        V = np.asarray(V, float)
+        return ((6 * s**2 - 6 * s) * (Q[k] - Q[k + 1]) / h + (3 * s**2 - 4 * s + 1) * V[k]
+                + (3 * s**2 - 2 * s) * V[k + 1])
 
     def row(self) -> dict:
         """One summary.csv row (without experiment/case columns, which the caller adds)."""

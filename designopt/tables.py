@@ -8,6 +8,7 @@ import pandas as pd
 
 from designopt.design_space import enumerate_structures
 from designopt.multistart import best_solution
+from designopt.search import cluster_designs, design_distance  # noqa: F401  (tables name them too)
 
 CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
 
@@ -56,29 +57,6 @@ def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
     table = pd.DataFrame(rows)
     order = {s: i for i, s in enumerate(enumerate_structures(1, 12))}
     return table.sort_values("structure", key=lambda c: c.map(order)).reset_index(drop=True)
-
-
-def design_distance(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> float:
-    """Largest difference between two designs: metres for lengths, radians (wrapped to [-pi, pi]) for angles."""
-    d = np.asarray(a, float) - np.asarray(b, float)
-    d = np.where(angle, np.arctan2(np.sin(d), np.cos(d)), d)
-    return float(np.max(np.abs(d))) if d.size else 0.0
-
-
-def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, tol: float = 0.02) -> np.ndarray:
-    """Label each design with its local optimum: in order of cost, a design joins the first (cheaper) cluster
-    whose representative lies within ``tol`` (m or rad) in every design joint, else starts a new one."""
-    order = np.argsort(costs, kind="stable")
-    labels, leaders = np.empty(len(costs), dtype=int), []
-    for i in order:
-        for k, j in enumerate(leaders):
-            if design_distance(designs[i], designs[j], angle) <= tol:
-                labels[i] = k
-                break
-        else:
-            labels[i] = len(leaders)
-            leaders.append(i)
-    return labels
 
 
 def solution_set(solutions: list, tol: float = 0.02) -> pd.DataFrame:

@@ -217,3 +217,17 @@ def read_csv(path: Path) -> np.ndarray:
                       InputWarning, stacklevel=2)
         points = np.delete(points, repeated, axis=0)
     return points
+
+
+def subsample(tp: Toolpath, n: int) -> Toolpath:
+    """The same task on ``n`` of its waypoints, evenly spread by index, first and last kept (n >= N: the path
+    itself). Times, points, tangents, forces and the tracked flags of the kept waypoints are unchanged, so the
+    coarse path's integrals are quadratures of the same task with longer steps (`Toolpath.weights`)."""
+    if n >= tp.n:
+        return tp
+    if n < 3:
+        raise ValueError(f"a coarse path needs at least 3 waypoints, got {n}")
+    keep = np.unique(np.linspace(0, tp.n - 1, n).round().astype(int))
+    tracked = None if tp.tracked is None else np.asarray(tp.tracked)[keep]
+    return Toolpath(tp.kind, tp.t[keep], tp.points_W[keep], tp.tangents_W[keep], tp.force_W[keep], tracked,
+                    tp.time_unit, tp.force_model, tuple((name, part[keep]) for name, part in tp.force_parts))

@@ -16,7 +16,7 @@ LAYERS = [
     ("designopt.config",),
     ("designopt.problem",),
     ("designopt.transcriptions", "designopt.initial_guess"),
-    ("designopt.evaluation", "designopt.solution", "designopt.results_io", "designopt.multistart"),
+    ("designopt.evaluation", "designopt.solution", "designopt.results_io", "designopt.multistart", "designopt.search"),
     ("designopt.tables", "designopt.style", "designopt.plots", "designopt.plots_experiments", "designopt.export",
      "designopt.view"),
     ("designopt.experiments",),

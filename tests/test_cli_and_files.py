@@ -21,7 +21,8 @@ runner = CliRunner()
 def finished_run(tmp_path_factory):
     root = tmp_path_factory.mktemp("run")
     config = root / "gantry.yaml"
-    cfg = gantry_config(solver={"multistart": 2, "jobs": 1, "max_iter": 200})
+    cfg = gantry_config(solver={"jobs": 1, "max_iter": 200,
+                                "search": {"explore_starts": 3, "explore_waypoints": 6, "refine": 2}})
     cfg["placement"]["optimize"] = ["x", "z"]
     config.write_text(yaml.safe_dump(cfg))
     result = runner.invoke(app, ["run", str(config), "--out", str(root / "results"), "--name", "t"])
@@ -41,12 +42,13 @@ def test_run_writes_the_run_directory(finished_run):
     assert "Plotly.newPlot" in view and "Plotly.addFrames" in view  # animated, plotly.js inside
     assert not re.search(r"<script[^>]+src=[\"']https?://", view)  # nothing to fetch: opens offline
     summary = pd.read_csv(run / "summary.csv")
-    assert len(summary) == 2
+    stages = summary["case"].value_counts()
+    assert stages["explore"] == 3 and 1 <= stages["refine"] <= 2  # 3 coarse starts, the best 2 optima refined
     required = ["experiment", "case", "method", "structure", "dof", "n_prismatic", "design_cost",
                 "max_position_error", "max_axis_error", "max_joint_step", "tracks", "status", "iterations",
                 "solve_time_s", "seed", "solution_file"]
     assert set(required) <= set(summary.columns)
-    assert summary["best"].sum() == 1
+    assert summary["best"].sum() == 1 and summary.loc[summary["best"], "case"].item() == "refine"
     assert (summary["stiffness_revolute"] == 1.0).all()
 
 
@@ -73,7 +75,7 @@ def test_piped_output_is_not_cut(finished_run):
 def test_every_solution_file_reverifies(finished_run):
     _, run = finished_run
     files = sorted((run / "solutions").glob("*.json")) + [run / "best.json"]
-    assert len(files) == 3
+    assert len(files) == len(pd.read_csv(run / "summary.csv")) + 1
     for f in files:
         data = json.loads(f.read_text())
         assert data["schema"] == "designopt.solution/1"
@@ -115,6 +117,14 @@ def test_the_solution_set_is_an_output(finished_run):
     _, run = finished_run
     optima = pd.read_csv(run / "solution_set.csv")
     summary = pd.read_csv(run / "summary.csv")
-    assert optima["reached_by"].sum() == summary["tracks"].sum()
+    explored = summary[summary["case"] == "explore"]
+    assert optima["reached_by"].sum() == explored["tracks"].sum()  # the exploration's optima, each solve once
     assert optima["design_cost"].is_monotonic_increasing and optima["ratio_to_best"].iloc[0] == 1.0
+    # every refined optimum carries its full-path cost, the one of the refine solve of its seed
+    refined = summary[summary["case"] == "refine"].set_index("seed")["design_cost"]
+    with_cost = optima.dropna(subset=["full_path_cost"])
+    assert len(with_cost) == len(refined)
+    for _, row in with_cost.iterrows():
+        seeds = [int(x) for x in str(row["seeds"]).split()]
+        assert row["full_path_cost"] == pytest.approx(min(refined[s] for s in seeds if s in refined.index), rel=1e-9)
     assert (run / "figures" / "search_progress.png").stat().st_size > 1000

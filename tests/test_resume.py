@@ -86,7 +86,8 @@ def _lose_first_file(run: Path, before: pd.DataFrame) -> None:
 
 
 def test_run_resumes(tmp_path):
-    config = _setup(tmp_path, {"name": "job", "solver": {**SMALL["solver"], "multistart": 5}})
+    search = {"explore_starts": 5, "explore_waypoints": 6, "refine": 2}
+    config = _setup(tmp_path, {"name": "job", "solver": {**SMALL["solver"], "search": search}})
     out, run = tmp_path / "r", tmp_path / "r" / "job" / "k"
     before = kill_part_way(["run", str(config), "--out", str(out), "--name", "k", "--no-figures"], run / "summary.csv")
     assert len(before) < 5, "the run was not killed part-way"
@@ -94,7 +95,9 @@ def test_run_resumes(tmp_path):
     again = runner.invoke(app, ["run", str(config), "--out", str(out), "--name", "k"])
     assert again.exit_code == 2 and "--resume" in again.output  # never overwrites a run silently
     result = runner.invoke(app, ["run", str(config), "--out", str(out), "--name", "k", "--resume", "--no-figures"])
-    after = check_resumed(run, before, {("", "to", "RRRRRR", s) for s in range(5)}, result)
+    refined = {k for k in read_summary(run / "summary.csv")[KEY].itertuples(index=False, name=None) if k[0] == "refine"}
+    assert 1 <= len(refined) <= 2  # the best two distinct coarse optima, refined on the full path
+    after = check_resumed(run, before, {("explore", "to", "RRRRRR", s) for s in range(5)} | refined, result)
     assert after["best"].sum() == 1 and (run / "best.json").is_file()
 
 

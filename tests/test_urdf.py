@@ -102,7 +102,7 @@ def test_ur10_placement_runs_tracks_and_reverifies(tmp_path):
     cfg = yaml.safe_load((ROOT / "configs" / "ur10_placement.yaml").read_text())
     cfg["robot"]["urdf"] = str(UR10)
     cfg["toolpath"]["waypoints"] = 30
-    cfg["solver"] = {**cfg["solver"], "multistart": 2, "jobs": 1}
+    cfg["solver"] = {**cfg["solver"], "jobs": 1, "search": {"explore_starts": 4, "refine": 2}}
     config = tmp_path / "ur10.yaml"
     config.write_text(yaml.safe_dump(cfg))
     result = CliRunner().invoke(app, ["run", str(config), "--out", str(tmp_path / "r"), "--name", "t", "--urdf"])

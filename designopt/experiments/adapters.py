@@ -9,9 +9,10 @@ from __future__ import annotations
 from designopt.config import Config
 from designopt.design_space import enumerate_structures
 from designopt.multistart import Multistart
+from designopt.search import Search
 from designopt.transcriptions import transcription_named
 
-__all__ = ["case_config", "enumerate_structures", "multistart_from_config", "structure_config", "transcription_for",
+__all__ = ["case_config", "enumerate_structures", "multistart_from_config", "search_from_config", "structure_config", "transcription_for",
            "with_waypoints"]
 
 
@@ -27,6 +28,12 @@ def transcription_for(cfg: Config, method: str = "to"):
 def multistart_from_config(cfg: Config) -> Multistart:
     s = cfg.solver
     return Multistart(count=s.multistart, seed=s.seed, scale=s.perturbation, init=s.init, jobs=s.jobs)
+
+
+def search_from_config(cfg: Config) -> Search:
+    s = cfg.solver.search
+    return Search(strategy=s.strategy, explore_waypoints=s.explore_waypoints, explore_starts=s.explore_starts,
+                  explore_max_iter=s.explore_max_iter, refine=s.refine, distinct=s.distinct)
 
 
 def case_config(cfg: Config, case: str) -> Config:

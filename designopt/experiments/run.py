@@ -8,18 +8,40 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.adapters import multistart_from_config, transcription_for
-from designopt.experiments.tasks import Progress, best_of, multistart_tasks, solve_tasks
-from designopt.problem import problem_from_config
+from designopt.experiments.adapters import multistart_from_config, search_from_config, transcription_for
+from designopt.experiments.tasks import Progress, Searched, best_of, search_problem
+from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
 from designopt.tables import best_so_far, solution_set
 
 
+def describe_search(cfg: Config) -> str:
+    s = cfg.solver.search
+    if s.strategy == "multistart":
+        return f"multistart, {cfg.solver.multistart} starts"
+    return (f"coarse to fine: {s.explore_starts} starts on {s.explore_waypoints} waypoints (<= {s.explore_max_iter} "
+            f"iterations), the best {s.refine} distinct optima refined on the full path")
+
+
+def searched_set(searched: Searched) -> pd.DataFrame:
+    """The distinct optima a search reached (`tables.solution_set`): of the exploration when there was one, with
+    the full-path cost of each optimum that was refined (``full_path_cost``, from the refine solve of its seed)."""
+    if not searched.explore:
+        return solution_set([sol for _, sol in searched.final])
+    table = solution_set([sol for _, sol in searched.explore])
+    refined = {sol.raw.seed: sol.metrics.design_cost for _, sol in searched.final if sol.metrics.tracks}
+    table["full_path_cost"] = [min((refined[int(x)] for x in seeds.split() if int(x) in refined), default=float("nan"))
+                               for seeds in table["seeds"].astype(str)]
+    return table
+
+
 @dataclass(frozen=True)
 class RunResult:
     directory: RunDirectory
-    solutions: list[Solution]
+    problem: DesignProblem
+    solutions: list[Solution]  # the solves on the full path (for coarse_to_fine: the refined optima)
+    explored: list[Solution]  # the exploration's solves on the coarse path (none for multistart)
     best: Solution | None
     summary: pd.DataFrame
     solution_set: pd.DataFrame  # the distinct local optima reached, best first (tables.solution_set)
@@ -33,19 +55,20 @@ def run_experiment(cfg: Config, base_dir: Path, out_root: Path, run_name: str | 
     run = RunDirectory.create(out_root, cfg.name, run_name, resume)
     run.write_config(dump_config(cfg))
     run.log(f"start {cfg.name}: structure {problem.chain.structure}, {problem.chain.n_design} design joints, "
-            f"{problem.toolpath.n} waypoints, {cfg.solver.multistart} starts")
-    settings = multistart_from_config(cfg)
-    tasks = multistart_tasks("", "to", problem, transcription_for(cfg), settings)
-    done = solve_tasks(run, tasks, cfg.name, settings.jobs, resume, progress)
-    best_task, best = best_of(done)
+            f"{problem.toolpath.n} waypoints, search {describe_search(cfg)}")
+    settings, search = multistart_from_config(cfg), search_from_config(cfg)
+    searched = search_problem(run, "", problem, transcription_for(cfg), settings, search, cfg.name, settings.jobs,
+                              resume, progress)
+    best_task, best = best_of(searched.final)
     summary = run.mark_best({best_task.file_name} if best is not None else set())
-    solutions = [sol for _, sol in done]
-    optima = solution_set(solutions)
+    solutions = [sol for _, sol in searched.explore + searched.final]
+    optima = searched_set(searched)
     optima.to_csv(run.path / "solution_set.csv", index=False)
     if figures:
         from designopt import plots_experiments
 
-        plots_experiments.search_progress_figure(best_so_far(summary), optima, run.figures)
+        explored = summary[summary["case"] == "explore"] if searched.explore else summary
+        plots_experiments.search_progress_figure(best_so_far(explored.reset_index(drop=True)), optima, run.figures)
     if best is not None:
         write_solution(best, run.path / "best.json")
         run.log(f"best: seed {best.raw.seed}, design cost {best.metrics.design_cost:.6g}; {len(optima)} distinct "
@@ -58,4 +81,5 @@ def run_experiment(cfg: Config, base_dir: Path, out_root: Path, run_name: str | 
             write_view(best, run.path / "view.html")
     else:
         run.log("no start tracks the path")
-    return RunResult(run, solutions, best, summary, optima)
+    return RunResult(run, problem, [sol for _, sol in searched.final], [sol for _, sol in searched.explore], best,
+                     summary, optima)

@@ -10,18 +10,20 @@ once (its solution file atomically, then its summary row), so a killed run keeps
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
-from designopt.multistart import Multistart, best_solution, solve_start
+from designopt.multistart import Multistart, best_solution, solve_guess, solve_start
 from designopt.problem import DesignProblem
 from designopt.results_io import RunDirectory
+from designopt.search import WARM_IPOPT, Search, coarse_problem, distinct_best, lifted_guess
 from designopt.solution import Solution, SolutionLoadError, read_solution_for, write_solution
 
 
 @dataclass(frozen=True)
 class Task:
-    """Start ``index`` of a seeded multistart of ``problem`` with ``transcription``, labelled ``case``."""
+    """Start ``index`` of a seeded multistart of ``problem`` with ``transcription``, labelled ``case``; with
+    ``warm``, the start is that solution (of another sampling of the same task) lifted to ``problem``."""
 
     case: str
     method: str
@@ -29,6 +31,7 @@ class Task:
     transcription: object
     settings: Multistart
     index: int
+    warm: Solution | None = None
 
     @property
     def seed(self) -> int:
@@ -70,6 +73,8 @@ def multistart_tasks(case: str, method: str, problem: DesignProblem, transcripti
 
 
 def _solve(task: Task) -> tuple[Task, Solution]:
+    if task.warm is not None:
+        return task, solve_guess(task.problem, task.transcription, lifted_guess(task.problem, task.warm), task.case)
     return task, solve_start(task.problem, task.transcription, task.settings, task.index, task.case)
 
 
@@ -133,3 +138,34 @@ def best_of(done: list[tuple[Task, Solution]]) -> tuple[Task | None, Solution | 
     """(task, solution) of the tracking solution with the lowest design cost, or (None, None)."""
     best = best_solution([sol for _, sol in done])
     return next(((t, s) for t, s in done if s is best), (None, None))
+
+
+@dataclass(frozen=True)
+class Searched:
+    """What a search of one problem solved: ``explore`` on the coarse path (empty for ``multistart``) and the
+    ``final`` solves on the full path, the ones a result is chosen from."""
+
+    explore: list[tuple[Task, Solution]]
+    final: list[tuple[Task, Solution]]
+
+
+def _stage(case: str, stage: str) -> str:
+    return f"{case}-{stage}" if case else stage
+
+
+def search_problem(run: RunDirectory, case: str, problem: DesignProblem, transcription, settings: Multistart,
+                   search: Search, experiment: str, jobs: int | None = -1, resume: bool = False,
+                   progress: Progress | None = None) -> Searched:
+    """Search one problem the way ``search`` says (`designopt.search`), writing every solve to ``run``."""
+    if search.strategy == "multistart":
+        tasks = multistart_tasks(case, "to", problem, transcription, settings)
+        return Searched([], solve_tasks(run, tasks, experiment, jobs, resume, progress))
+    explore = multistart_tasks(_stage(case, "explore"), "to", coarse_problem(problem, search.explore_waypoints),
+                               replace(transcription, max_iter=search.explore_max_iter),
+                               replace(settings, count=search.explore_starts))
+    explored = sorted(solve_tasks(run, explore, experiment, jobs, resume, progress), key=lambda d: d[0].index)
+    picked = distinct_best([sol for _, sol in explored], search.refine, search.distinct)
+    warm = replace(transcription, ipopt={**transcription.ipopt, **WARM_IPOPT})
+    refine = [Task(_stage(case, "refine"), "to", problem, warm, settings, explored[i][0].index, explored[i][1])
+              for i in picked]
+    return Searched(explored, solve_tasks(run, refine, experiment, jobs, resume, progress))
