@@ -12,8 +12,8 @@ from designopt.multistart import Multistart
 from designopt.search import Search
 from designopt.transcriptions import transcription_named
 
-__all__ = ["case_config", "enumerate_structures", "multistart_from_config", "search_from_config", "structure_config", "transcription_for",
-           "with_waypoints"]
+__all__ = ["case_config", "enumerate_structures", "multistart_from_config", "search_from_config", "structure_config",
+           "transcription_for", "with_waypoints"]
 
 
 def transcription_for(cfg: Config, method: str = "to"):
