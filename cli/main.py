@@ -155,7 +155,7 @@ def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/
     out.print(f"stiffness: {s.stiffness.describe()}; deflection: {s.deflection}")
     out.print(f"NLP (TO, {s.tracking} tracking, {s.kinematics} kinematics): {s.n_variables} variables, "
               f"{s.n_constraints} constraints; built in {s.build_time_s:.2f} s")
-    out.print(f"a run solves {s.starts} start(s); nothing was solved")
+    out.print(f"a run searches it by {s.search}; nothing was solved")
 
 
 class Bar:

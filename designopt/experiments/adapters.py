@@ -12,8 +12,8 @@ from designopt.multistart import Multistart
 from designopt.search import Search
 from designopt.transcriptions import transcription_named
 
-__all__ = ["case_config", "enumerate_structures", "multistart_from_config", "search_from_config", "structure_config",
-           "transcription_for", "with_waypoints"]
+__all__ = ["case_config", "describe_search", "enumerate_structures", "multistart_from_config", "search_from_config",
+           "structure_config", "transcription_for", "with_waypoints"]
 
 
 def transcription_for(cfg: Config, method: str = "to"):
@@ -34,6 +34,15 @@ def search_from_config(cfg: Config) -> Search:
     s = cfg.solver.search
     return Search(strategy=s.strategy, explore_waypoints=s.explore_waypoints, explore_starts=s.explore_starts,
                   explore_max_iter=s.explore_max_iter, refine=s.refine, distinct=s.distinct)
+
+
+def describe_search(cfg: Config) -> str:
+    """The config's search in words."""
+    s = cfg.solver.search
+    if s.strategy == "multistart":
+        return f"multistart, {cfg.solver.multistart} starts"
+    return (f"coarse to fine: {s.explore_starts} starts on {s.explore_waypoints} waypoints (<= {s.explore_max_iter} "
+            f"iterations), the best {s.refine} distinct optima refined on the full path")
 
 
 def case_config(cfg: Config, case: str) -> Config:

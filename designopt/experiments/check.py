@@ -14,7 +14,7 @@ import numpy as np
 
 from designopt.config import Config
 from designopt.costs import Stiffness
-from designopt.experiments.adapters import transcription_for
+from designopt.experiments.adapters import describe_search, transcription_for
 from designopt.kinematics.joints import Joint
 from designopt.problem import problem_from_config
 
@@ -44,7 +44,7 @@ class ProblemSummary:
     n_variables: int
     n_constraints: int
     build_time_s: float
-    starts: int
+    search: str  # how `designopt run` would search it, in words
 
 
 def _describe_cell(cell) -> str:
@@ -75,5 +75,5 @@ def check_config(cfg: Config, base_dir: Path) -> ProblemSummary:
         cell=_describe_cell(problem.cell), stiffness=problem.stiffness,
         deflection=problem.deflection, tracking=cfg.solver.tracking, kinematics=cfg.solver.kinematics,
         n_variables=nlp.n_variables, n_constraints=nlp.n_constraints, build_time_s=build,
-        starts=cfg.solver.multistart,
+        search=describe_search(cfg),
     )

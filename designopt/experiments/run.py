@@ -8,20 +8,17 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.adapters import multistart_from_config, search_from_config, transcription_for
+from designopt.experiments.adapters import (
+    describe_search,
+    multistart_from_config,
+    search_from_config,
+    transcription_for,
+)
 from designopt.experiments.tasks import Progress, Searched, best_of, search_problem
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
 from designopt.tables import best_so_far, solution_set
-
-
-def describe_search(cfg: Config) -> str:
-    s = cfg.solver.search
-    if s.strategy == "multistart":
-        return f"multistart, {cfg.solver.multistart} starts"
-    return (f"coarse to fine: {s.explore_starts} starts on {s.explore_waypoints} waypoints (<= {s.explore_max_iter} "
-            f"iterations), the best {s.refine} distinct optima refined on the full path")
 
 
 def searched_set(searched: Searched) -> pd.DataFrame:

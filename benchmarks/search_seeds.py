@@ -1,0 +1,73 @@
+"""Does the answer depend on the seed? `designopt run CONFIG --no-figures` for several search seeds (issue 11).
+
+Each seed is one run of the CLI in a subprocess (wall time includes start-up, the NLP builds and the search);
+its best design cost is compared with the best design known for the problem (a solution file).
+
+    .venv/bin/python benchmarks/search_seeds.py [--config configs/milling.yaml] [--seeds 5]
+        [--reference benchmarks/reference/milling_best_known.json] [--set solver.search.strategy=multistart]
+
+Prints one line per seed, then the spread between seeds and the worst ratio to the best known.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _set(cfg: dict, dotted: str, value) -> None:
+    *path, last = dotted.split(".")
+    for key in path:
+        cfg = cfg.setdefault(key, {})
+    cfg[last] = value
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--config", default="configs/milling.yaml")
+    parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--reference", default="benchmarks/reference/milling_best_known.json")
+    parser.add_argument("--set", action="append", default=[], help="KEY=VALUE (YAML value), e.g. "
+                                                                     "solver.search.explore_starts=120")
+    args = parser.parse_args()
+    config = ROOT / args.config
+    base = yaml.safe_load(config.read_text())
+    for item in args.set:
+        key, value = item.split("=", 1)
+        _set(base, key, yaml.safe_load(value))
+    known = json.loads((ROOT / args.reference).read_text())["metrics"]["design_cost"] if args.reference else None
+    ratios = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed in range(args.seeds):
+            cfg = json.loads(json.dumps(base))
+            _set(cfg, "solver.seed", seed)
+            path = config.parent / f".bench-seed{seed}.yaml"  # beside the original: relative files resolve
+            path.write_text(yaml.safe_dump(cfg))
+            try:
+                t0 = time.perf_counter()
+                subprocess.run([sys.executable, "-m", "cli.main", "run", str(path), "--out", tmp, "--name", f"s{seed}",
+                                "--no-figures"], cwd=ROOT, check=True, capture_output=True)
+                wall = time.perf_counter() - t0
+            finally:
+                path.unlink()
+            best = json.loads((Path(tmp) / cfg["name"] / f"s{seed}" / "best.json").read_text())["metrics"]
+            cost = best["design_cost"]
+            ratios.append(cost / known if known else cost)
+            extra = f" ({cost / known:.3f}x best known)" if known else ""
+            print(f"seed {seed}: best {cost:.6g}{extra}, {wall:.1f} s wall", flush=True)
+    if known:
+        print(f"spread between seeds {max(ratios) / min(ratios):.3f}x; worst {max(ratios):.3f}x, best "
+              f"{min(ratios):.3f}x the best known ({known:.6g})")
+
+
+if __name__ == "__main__":
+    main()
