@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 # The tests that guard the objective; each mutation runs them with -x (stop at the first failure).
 TESTS = ["tests/test_objective_truth.py", "tests/test_costs_and_toolpaths.py", "tests/test_kinematics.py",
          "tests/test_collocation.py", "tests/test_fk.py", "tests/test_cli_and_files.py", "tests/test_urdf.py",
-         "tests/test_gcode.py", "tests/test_forces.py", "tests/test_clearance.py"]
+         "tests/test_gcode.py", "tests/test_forces.py", "tests/test_clearance.py", "tests/test_search.py"]
 
 
 @dataclass(frozen=True)
@@ -91,6 +91,11 @@ MUTATIONS = [
              "need = cell.clearance + length / (2 * (n - 1))"),
     Mutation("per-joint stiffness read in reverse", "designopt/costs.py",
              "return np.array(self.per_joint, dtype=float)", "return np.array(self.per_joint[::-1], dtype=float)"),
+    # the search (issue 11)
+    Mutation("search refines the most expensive coarse optima", "designopt/search.py",
+             "for k in np.argsort(costs, kind=\"stable\"):", "for k in np.argsort(-costs, kind=\"stable\"):"),
+    Mutation("lifted start drops the coarse design", "designopt/search.py",
+             "q_d=np.asarray(solution.raw.q_d, float)", "q_d=problem.chain.design_values"),
 ]
 
 
