@@ -93,7 +93,7 @@ def run(
     resume: Annotated[bool, typer.Option("--resume", help="Finish the run --name: keep its finished starts, "
                                                           "solve the rest.")] = False,
 ):
-    """Solve one design problem (multistart TO) and write results/<experiment>/<run>/."""
+    """Solve one design problem (TO, searched: README "Search") and write results/<experiment>/<run>/."""
     from designopt.experiments.run import run_experiment
 
     cfg = load(config)

@@ -1,4 +1,4 @@
-"""``designopt run``: one config, one multistart TO solve, one run directory."""
+"""``designopt run``: one config, one searched TO problem (designopt.search), one run directory."""
 
 from __future__ import annotations
 
