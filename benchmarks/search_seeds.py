@@ -36,6 +36,8 @@ def main() -> None:
     parser.add_argument("--config", default="configs/milling.yaml")
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--reference", default="benchmarks/reference/milling_best_known.json")
+    parser.add_argument("--first-seed", type=int, default=0)
+    parser.add_argument("--out", help="keep the runs here (default: a temporary directory)")
     parser.add_argument("--set", action="append", default=[], help="KEY=VALUE (YAML value), e.g. "
                                                                      "solver.search.explore_starts=120")
     args = parser.parse_args()
@@ -46,8 +48,9 @@ def main() -> None:
         _set(base, key, yaml.safe_load(value))
     known = json.loads((ROOT / args.reference).read_text())["metrics"]["design_cost"] if args.reference else None
     ratios = []
-    with tempfile.TemporaryDirectory() as tmp:
-        for seed in range(args.seeds):
+    with tempfile.TemporaryDirectory() as scratch:
+        tmp = args.out or scratch
+        for seed in range(args.first_seed, args.first_seed + args.seeds):
             cfg = json.loads(json.dumps(base))
             _set(cfg, "solver.seed", seed)
             path = config.parent / f".bench-seed{seed}.yaml"  # beside the original: relative files resolve

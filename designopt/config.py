@@ -193,6 +193,8 @@ class SearchConfig(_Strict):
     explore_max_iter: Annotated[int, Field(ge=1, le=1_000_000)] = 250
     refine: Annotated[int, Field(ge=1, le=1000)] = 4
     distinct: Annotated[float, Field(gt=0)] = 0.02  # m or rad
+    screen_waypoints: Annotated[int, Field(ge=0, le=5000)] = 40  # 0 (or >= the path's waypoints): no screening
+    screen: Annotated[int, Field(ge=1, le=1000)] = 12
 
 
 class SolverConfig(_Strict):

@@ -10,10 +10,14 @@ than not, in the basin of a design optimal for the full path. So the default sea
    the same robot, placement, costs and cell on ``explore_waypoints`` of the path's waypoints
    (`toolpaths.subsample`) -- each capped at ``explore_max_iter`` IPOPT iterations. A coarse solve costs about
    a tenth of a full one, so the same budget visits ten times as many basins.
-2. **refine**: the ``refine`` best *distinct* coarse optima (designs further apart than ``distinct`` in some
-   design joint: `cluster_designs`) are lifted to the full path -- design as is, trajectory sampled from the
-   coarse cubic (`lifted_guess`) -- and solved warm: IPOPT's barrier starts small (`WARM_IPOPT`) so that the
-   solve stays in the basin it was given instead of being pushed off its active bounds.
+2. **screen** (when ``screen_waypoints`` is between 0 and the path's waypoints): the ``screen`` best distinct
+   coarse optima are lifted to a finer sampling (``screen_waypoints``) and solved warm, and ranked again there:
+   the 10-waypoint ranking alone often puts a design that lifts badly ahead of one that lifts well.
+3. **refine**: the ``refine`` best *distinct* screened (or coarse) optima (designs further apart than
+   ``distinct`` in some design joint: `cluster_designs`) are lifted to the full path -- design as is,
+   trajectory sampled from the coarser cubic (`lifted_guess`) -- and solved warm: IPOPT's barrier starts
+   small (`WARM_IPOPT`) so that the solve stays in the basin it was given instead of being pushed off its
+   active bounds.
 
 ``strategy: multistart`` is the plain alternative: ``solver.multistart`` cold starts on the full path.
 """
@@ -45,7 +49,9 @@ class Search:
     explore_starts: int = 80
     explore_max_iter: int = 250
     refine: int = 4
-    distinct: float = 0.02  # m or rad: coarse optima closer than this in every design joint are one optimum
+    distinct: float = 0.02
+    screen_waypoints: int = 40  # re-rank the best ``screen`` coarse optima on this many waypoints first (0: don't)
+    screen: int = 12  # m or rad: coarse optima closer than this in every design joint are one optimum
 
     def __post_init__(self):
         if self.strategy not in STRATEGIES:

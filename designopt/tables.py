@@ -40,19 +40,36 @@ def best_per_dof(table: pd.DataFrame) -> pd.DataFrame:
     return tracking.groupby("dof").head(1).sort_values("dof")
 
 
+def _stage_of(case) -> str:
+    """The search stage of a summary row: explore, screen, or final (refine, or a plain multistart start)."""
+    case = str(case)
+    return next((st for st in ("explore", "screen") if case == st or case.endswith("-" + st)), "final")
+
+
 def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
-    """One row per structure: best tracking start (cost NaN if none tracks), starts, statuses."""
+    """One row per structure: best tracking full-path solve (cost NaN if none tracks), how many full-path solves
+    reached within 5 % of it (``near_best``) and, for a coarse-to-fine search, how many exploration solves came
+    within 5 % of the exploration's best (``explore_near_best`` of ``explore_starts``); statuses."""
     rows = []
+    stage = summary["case"].map(_stage_of) if "case" in summary else pd.Series("final", index=summary.index)
+    tracks = summary["tracks"].astype(str) == "True"
     for structure, group in summary.groupby("structure", sort=False):
-        tracking = group[group["tracks"].astype(str) == "True"]
+        final = group[stage[group.index] == "final"]
+        explore = group[(stage[group.index] == "explore") & tracks[group.index]]
+        tracking = final[tracks[final.index]]
         best = tracking.loc[tracking["design_cost"].idxmin()] if len(tracking) else None
+        cost = best["design_cost"] if best is not None else float("nan")
         rows.append({
             "structure": structure, "dof": len(structure), "n_prismatic": structure.count("P"),
-            "design_cost": best["design_cost"] if best is not None else float("nan"),
-            "tracking_starts": len(tracking), "starts": len(group),
-            "statuses": ";".join(sorted(set(group["status"]))),
+            "design_cost": cost,
+            "tracking_starts": len(tracking), "starts": len(final),
+            "near_best": int((tracking["design_cost"] <= 1.05 * cost).sum()),
+            "explore_near_best": int((explore["design_cost"] <= 1.05 * explore["design_cost"].min()).sum()),
+            "explore_starts": int((stage[group.index] == "explore").sum()),
+            "statuses": ";".join(sorted(set(final["status"]))),
             "best_solution": best["solution_file"] if best is not None else "",
             "median_solve_time_s": group["solve_time_s"].median(),
+            "solver_time_s": group["solve_time_s"].sum(),
         })
     table = pd.DataFrame(rows)
     order = {s: i for i, s in enumerate(enumerate_structures(1, 12))}

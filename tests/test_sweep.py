@@ -38,7 +38,8 @@ def small_config(tmp_path, **solver) -> Path:
         "name": "structures",
         "toolpath": {"kind": "line", "length": 0.2, "waypoints": 8},
         "placement": {"xyz": [0.3, 0.0, -0.2]},
-        "solver": {"multistart": 1, "max_iter": 200, **solver},
+        "solver": {"max_iter": 200, "search": {"explore_starts": 3, "explore_waypoints": 5, "refine": 1},
+                   **solver},
     }))
     return path
 
@@ -57,10 +58,16 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "structures" / "a"
     summary = pd.read_csv(run / "summary.csv")
-    assert sorted(summary["structure"]) == sorted(["R", "P", "RR", "RP", "PR", "PP"])
+    assert set(summary["structure"]) == {"R", "P", "RR", "RP", "PR", "PP"}
+    stages = summary.groupby(["structure", "case"]).size()
+    for s in ("RR", "RP", "PR", "PP"):  # every structure gets the same search: 3 coarse starts, the best refined
+        assert stages[s, "sweep-explore"] == 3 and stages.get((s, "sweep-refine"), 0) <= 1
     assert "6 structures solved" in result.output
     table = pd.read_csv(run / "table.csv")
     assert list(table["structure"]) == ["R", "P", "RR", "RP", "PR", "PP"]
+    assert (table["explore_starts"] == 3).all()
+    refined = table[table["starts"] == 1]
+    assert (refined["near_best"] == refined["tracking_starts"]).all()  # one full-path solve: it is its own best
     for f in (run / "solutions").glob("*.json"):
         assert verify_file(f) == [], f
     assert (run / "figures" / "structures_best_per_dof.png").is_file()
@@ -69,16 +76,19 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
 
 
 def test_failed_solves_are_rows(tmp_path):
-    # 1 joint cannot meet 5 tracking equalities per waypoint (IPOPT: Not_Enough_Degrees_Of_Freedom);
-    # 2 joints stopped after 2 iterations do not converge (Maximum_Iterations_Exceeded). Both are rows.
-    result = sweep(small_config(tmp_path, max_iter=2), tmp_path / "r", "--max-dof", "2", "--jobs", "1")
+    # 1 revolute joint cannot meet 5 tracking equalities per waypoint (IPOPT: Not_Enough_Degrees_Of_Freedom);
+    # 2 joints stopped after 2 iterations do not converge (Maximum_Iterations_Exceeded, or a failed
+    # restoration). All are rows.
+    result = sweep(small_config(tmp_path, max_iter=2, search={"explore_starts": 3, "explore_waypoints": 5,
+                                                                "explore_max_iter": 2}),
+                   tmp_path / "r", "--max-dof", "2", "--jobs", "1")
     assert result.exit_code == 0, result.output
     summary = pd.read_csv(tmp_path / "r" / "structures" / "sweep" / "summary.csv")
-    assert len(summary) == 6
+    assert len(summary) == 6 * 3 and (summary["case"] == "sweep-explore").all()  # nothing tracks: nothing refined
     assert not summary["success"].any() and not summary["tracks"].any()
-    statuses = dict(zip(summary["structure"], summary["status"], strict=True))
-    assert statuses["R"] == statuses["P"] == "Not_Enough_Degrees_Of_Freedom"
-    assert statuses["RR"] == "Maximum_Iterations_Exceeded"
+    statuses = summary.groupby("structure")["status"].agg(set)
+    assert statuses["R"] == {"Not_Enough_Degrees_Of_Freedom"}
+    assert "Maximum_Iterations_Exceeded" in statuses["RR"]
     assert "0 track the path" in result.output
 
 
@@ -102,14 +112,17 @@ def test_killed_sweep_resumes_without_losing_or_repeating(tmp_path):
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     before = pd.read_csv(summary)
-    assert 3 <= len(before) < 14, "the sweep was not killed part-way"
+    assert 3 <= len(before) < 14 * 3, "the sweep was not killed part-way"
     kept = {f: _digest(out / "structures" / "k" / f) for f in before["solution_file"]}
     prefix = summary.read_bytes()
 
     result = sweep(config, out, "--min-dof", "1", "--max-dof", "3", "--jobs", "2", "--name", "k", "--resume")
     assert result.exit_code == 0, result.output
     after = pd.read_csv(summary)
-    assert sorted(after["structure"]) == sorted(enumerate_structures(1, 3))  # each exactly once
+    assert set(after["structure"]) == set(enumerate_structures(1, 3))
+    assert not after.duplicated(["case", "structure", "seed"]).any()  # each solve exactly once
+    explored = after[after["case"] == "sweep-explore"].groupby("structure").size()
+    assert (explored == 3).all()
     assert summary.read_bytes().startswith(prefix)  # finished rows untouched, byte for byte
     for f, digest in kept.items():
         assert _digest(out / "structures" / "k" / f) == digest
@@ -121,9 +134,10 @@ def test_dask_local_cluster_gives_the_same_rows_as_loky(tmp_path):
     a = sweep(config, tmp_path / "r", "--max-dof", "1", "--name", "loky", "--jobs", "2")
     b = sweep(config, tmp_path / "r", "--max-dof", "1", "--name", "dask", "--backend", "dask", "--jobs", "2")
     assert a.exit_code == 0 and b.exit_code == 0, (a.output, b.output)
-    cols = ["structure", "seed", "status", "iterations", "design_cost", "tracks"]
-    loky = pd.read_csv(tmp_path / "r" / "structures" / "loky" / "summary.csv")[cols].sort_values("structure")
-    dask = pd.read_csv(tmp_path / "r" / "structures" / "dask" / "summary.csv")[cols].sort_values("structure")
+    cols = ["structure", "case", "seed", "status", "iterations", "design_cost", "tracks"]
+    order = ["structure", "case", "seed"]
+    loky = pd.read_csv(tmp_path / "r" / "structures" / "loky" / "summary.csv")[cols].sort_values(order)
+    dask = pd.read_csv(tmp_path / "r" / "structures" / "dask" / "summary.csv")[cols].sort_values(order)
     pd.testing.assert_frame_equal(loky.reset_index(drop=True), dask.reset_index(drop=True), rtol=1e-9)
 
 

@@ -1,9 +1,9 @@
 """Kinematic structure sweep (SPEC §5, claims C4-C6): every structure over {R, P} with n joints.
 
 Each structure gets its continuous design joints (R link: d, a, alpha; P link: theta, a, alpha) plus the
-six placement joints, and is solved by TO with multistart. Every (structure, start) is one task, fanned
-out with joblib (loky processes, or a dask.distributed cluster); each finished solve is written at once,
-so a killed sweep keeps what it finished and ``resume`` solves only the rest.
+six placement joints, and the same search (`designopt.search`, `solver.search`). Each stage's solves of all
+structures are fanned out together with joblib (loky processes, or a dask.distributed cluster); each finished
+solve is written at once, so a killed sweep keeps what it finished and ``resume`` solves only the rest.
 """
 
 from __future__ import annotations
@@ -16,33 +16,26 @@ import pandas as pd
 
 from designopt.config import Config, dump_config
 from designopt.experiments.adapters import (
+    describe_search,
     enumerate_structures,
     multistart_from_config,
+    search_from_config,
     structure_config,
     transcription_for,
 )
-from designopt.experiments.tasks import Progress, Task, multistart_tasks, solve_tasks
+from designopt.experiments.tasks import Progress, Searchable, search_problems
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.tables import best_per_dof, structure_table
 
 
-@dataclass(frozen=True)
-class SweepPlan:
-    structures: list[str]
-    tasks: list[Task]
-    skipped: int
-
-
-def plan(cfg: Config, base_dir: Path, structures: list[str], done: set) -> SweepPlan:
-    """Every (structure, start) task of the sweep; ``tasks`` are those not in ``done`` (finished keys)."""
-    settings = multistart_from_config(cfg)
-    tasks = []
+def searchables(cfg: Config, base_dir: Path, structures: list[str]) -> list[Searchable]:
+    """Every structure's problem (generic start design, d/theta, a, alpha of every link and the placement free)."""
+    items = []
     for structure in structures:
         c = structure_config(cfg, structure)
-        tasks += multistart_tasks("sweep", "to", problem_from_config(c, base_dir), transcription_for(c), settings)
-    todo = [t for t in tasks if t.key not in done]
-    return SweepPlan(structures, todo, len(tasks) - len(todo))
+        items.append(Searchable("sweep", problem_from_config(c, base_dir), transcription_for(c)))
+    return items
 
 
 @contextmanager
@@ -91,18 +84,17 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
     if min_dof > max_dof:
         raise cfg.error("--min-dof", f"{min_dof} is above --max-dof {max_dof}")
     structures = enumerate_structures(min_dof, max_dof)
-    plan(cfg, base_dir, structures[:1], set())  # bad input stops here, before a run directory exists
+    searchables(cfg, base_dir, structures[:1])  # bad input stops here, before a run directory exists
     run = RunDirectory.create(out_root, cfg.name, run_name, resume)
     run.write_config(dump_config(cfg))
-    sweep_plan = plan(cfg, base_dir, structures, set(run.resume()) if resume else set())
-    run.log(f"sweep {min_dof}..{max_dof} DOF: {len(structures)} structures, {len(sweep_plan.tasks)} "
-            f"solves to do, {sweep_plan.skipped} already done")
-    if progress:
-        progress.planned(len(sweep_plan.tasks) + sweep_plan.skipped, sweep_plan.skipped)
-    if sweep_plan.tasks:
-        with backend(backend_name, scheduler, jobs):
-            # the plan already left out finished solves; their rows stay, and the table reads them
-            solve_tasks(run, sweep_plan.tasks, cfg.name, jobs=None, progress=_Solved(progress))
+    before = len(run.resume()) if resume else 0
+    run.log(f"sweep {min_dof}..{max_dof} DOF: {len(structures)} structures, search {describe_search(cfg)}; "
+            f"{before} solves already done")
+    with backend(backend_name, scheduler, jobs):
+        # every structure gets the same search, stage by stage across all of them (workers stay busy)
+        search_problems(run, searchables(cfg, base_dir, structures), multistart_from_config(cfg),
+                        search_from_config(cfg), cfg.name, jobs=None, resume=resume, progress=progress)
+    after = len(pd.read_csv(run.summary))
     summary = pd.read_csv(run.summary)
     table = structure_table(summary)
     table.to_csv(run.path / "table.csv", index=False)
@@ -111,18 +103,4 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
 
         plots_experiments.structure_figures(table, run.figures, summary)
     run.log("done")
-    return SweepResult(run, table, best_per_dof(table), len(structures), len(sweep_plan.tasks), sweep_plan.skipped)
-
-
-class _Solved:
-    """Pass on finished solves only: the sweep announced its whole plan itself."""
-
-    def __init__(self, progress: Progress | None):
-        self.progress = progress
-
-    def planned(self, solves: int, finished: int = 0) -> None:
-        pass
-
-    def solved(self, task, solution) -> None:
-        if self.progress:
-            self.progress.solved(task, solution)
+    return SweepResult(run, table, best_per_dof(table), len(structures), after - before, before)

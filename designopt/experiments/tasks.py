@@ -153,19 +153,72 @@ def _stage(case: str, stage: str) -> str:
     return f"{case}-{stage}" if case else stage
 
 
+@dataclass(frozen=True)
+class Searchable:
+    """One problem to search: its ``case`` label (stages append -explore, -screen, -refine) and transcription."""
+
+    case: str
+    problem: DesignProblem
+    transcription: object
+
+
+def _by_problem(items: list[Searchable], done: list[tuple[Task, Solution]], stage: str) -> list[list]:
+    """Split one stage's (task, solution) pairs by the problem they belong to, each list in start order."""
+    where = {(_stage(it.case, stage), it.problem.chain.structure): k for k, it in enumerate(items)}
+    out = [[] for _ in items]
+    for task, sol in done:
+        out[where[task.case, task.problem.chain.structure]].append((task, sol))
+    return [sorted(d, key=lambda d: d[0].index) for d in out]
+
+
+def _lifted_tasks(items: list[Searchable], found: list[list], count: int, stage: str, waypoints: int | None,
+                  settings: Multistart, search: Search) -> list[Task]:
+    """For every problem, its ``count`` best distinct solutions lifted to ``waypoints`` (None: the full path)."""
+    tasks = []
+    for it, done in zip(items, found, strict=True):
+        problem = it.problem if waypoints is None else coarse_problem(it.problem, waypoints)
+        warm = replace(it.transcription, ipopt={**it.transcription.ipopt, **WARM_IPOPT})
+        for i in distinct_best([sol for _, sol in done], count, search.distinct):
+            tasks.append(Task(_stage(it.case, stage), "to", problem, warm, settings, done[i][0].index, done[i][1]))
+    return tasks
+
+
+def search_problems(run: RunDirectory, items: list[Searchable], settings: Multistart, search: Search,
+                    experiment: str, jobs: int | None = -1, resume: bool = False,
+                    progress: Progress | None = None) -> list[Searched]:
+    """Search several problems the way ``search`` says (`designopt.search`), one stage at a time across all of
+    them (so that workers stay busy), writing every solve to ``run``. Problems are told apart by case and
+    structure."""
+    if search.strategy == "multistart":
+        tasks = [t for it in items for t in multistart_tasks(it.case, "to", it.problem, it.transcription, settings)]
+        done = solve_tasks(run, tasks, experiment, jobs, resume, progress)
+        where = {(it.case, it.problem.chain.structure): k for k, it in enumerate(items)}
+        final = [[] for _ in items]
+        for task, sol in done:
+            final[where[task.case, task.problem.chain.structure]].append((task, sol))
+        return [Searched([], sorted(f, key=lambda d: d[0].index)) for f in final]
+    explore = [t for it in items for t in multistart_tasks(
+        _stage(it.case, "explore"), "to", coarse_problem(it.problem, search.explore_waypoints),
+        replace(it.transcription, max_iter=search.explore_max_iter), replace(settings, count=search.explore_starts))]
+    explored = _by_problem(items, solve_tasks(run, explore, experiment, jobs, resume, progress), "explore")
+    candidates = explored
+    screened = [k for k, it in enumerate(items) if 0 < search.screen_waypoints < it.problem.toolpath.n]
+    if screened:
+        # rank the best distinct coarse optima again on a finer (still cheap) sampling before the full path
+        sub = [items[k] for k in screened]
+        tasks = _lifted_tasks(sub, [explored[k] for k in screened], search.screen, "screen", search.screen_waypoints,
+                              settings, search)
+        found = dict(zip(screened, _by_problem(sub, solve_tasks(run, tasks, experiment, jobs, resume, progress),
+                                                "screen"), strict=True))
+        candidates = [found.get(k, explored[k]) for k in range(len(items))]
+    tasks = _lifted_tasks(items, candidates, search.refine, "refine", None, settings, search)
+    final = _by_problem(items, solve_tasks(run, tasks, experiment, jobs, resume, progress), "refine")
+    return [Searched(e, f) for e, f in zip(explored, final, strict=True)]
+
+
 def search_problem(run: RunDirectory, case: str, problem: DesignProblem, transcription, settings: Multistart,
                    search: Search, experiment: str, jobs: int | None = -1, resume: bool = False,
                    progress: Progress | None = None) -> Searched:
-    """Search one problem the way ``search`` says (`designopt.search`), writing every solve to ``run``."""
-    if search.strategy == "multistart":
-        tasks = multistart_tasks(case, "to", problem, transcription, settings)
-        return Searched([], solve_tasks(run, tasks, experiment, jobs, resume, progress))
-    explore = multistart_tasks(_stage(case, "explore"), "to", coarse_problem(problem, search.explore_waypoints),
-                               replace(transcription, max_iter=search.explore_max_iter),
-                               replace(settings, count=search.explore_starts))
-    explored = sorted(solve_tasks(run, explore, experiment, jobs, resume, progress), key=lambda d: d[0].index)
-    picked = distinct_best([sol for _, sol in explored], search.refine, search.distinct)
-    warm = replace(transcription, ipopt={**transcription.ipopt, **WARM_IPOPT})
-    refine = [Task(_stage(case, "refine"), "to", problem, warm, settings, explored[i][0].index, explored[i][1])
-              for i in picked]
-    return Searched(explored, solve_tasks(run, refine, experiment, jobs, resume, progress))
+    """Search one problem (`search_problems`)."""
+    return search_problems(run, [Searchable(case, problem, transcription)], settings, search, experiment, jobs,
+                           resume, progress)[0]
