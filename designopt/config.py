@@ -250,6 +250,8 @@ class ModularConfig(_Strict):
     weight_study: list[Positive] = [1.0e-4, 1.0e-3, 1.0e-2]
     enumeration_modules: Annotated[list[Annotated[int, Field(ge=1)]], Field(min_length=1, max_length=3)] = [2, 5]
     enumeration_waypoints: Annotated[int, Field(ge=3)] = 40
+    # after rounding: a local search over module assignments, at most this many assignments evaluated (0: off)
+    neighbourhood_budget: Annotated[int, Field(ge=0, le=100_000)] = 48
 
 
 class BlockConfig(_Strict):

@@ -88,3 +88,39 @@ def check_catalogue(structure: str, catalogue: Catalogue) -> None:
     if set(structure) != {catalogue.joint_type}:
         raise ValueError(f"structure {structure} mixes joint types; all modules are {catalogue.joint_type} "
                          f"joints (the three-step method assumes one joint type and a fixed number of joints)")
+
+
+def neighbours(assignment: tuple[int, ...], n_modules: int) -> list[tuple[int, ...]]:
+    """Every assignment that differs from ``assignment`` in one link's module."""
+    return [assignment[:i] + (k,) + assignment[i + 1:] for i in range(len(assignment)) for k in range(n_modules)
+            if k != assignment[i]]
+
+
+def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate, budget: int):
+    """Best-improvement local search over module assignments, from each of ``starts`` in turn.
+
+    ``evaluate(assignments) -> costs`` solves a batch (NaN or inf: does not track); an assignment is evaluated
+    at most once. A step evaluates every neighbour of the incumbent (one link's module changed) and moves to
+    the cheapest if it beats the incumbent; a start ends at a local optimum of this neighbourhood or when
+    ``budget`` evaluations are spent. Returns (best assignment, its cost, every evaluation in order).
+    """
+    seen: dict[tuple[int, ...], float] = {}
+
+    def costs(batch):
+        new = [a for a in dict.fromkeys(batch) if a not in seen][: max(budget - len(seen), 0)]
+        if new:
+            seen.update({a: (float(c) if np.isfinite(c) else np.inf) for a, c in zip(new, evaluate(new), strict=True)})
+        return [seen.get(a, np.inf) for a in batch]
+
+    for start in starts:
+        current = tuple(start)
+        (cost,) = costs([current])
+        while len(seen) < budget:
+            around = neighbours(current, n_modules)
+            values = costs(around)
+            k = int(np.argmin(values))
+            if values[k] >= cost:
+                break
+            current, cost = around[k], values[k]
+    best = min(seen, key=seen.get)
+    return list(best), seen[best], list(seen.items())

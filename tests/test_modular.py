@@ -16,7 +16,14 @@ from designopt.config import parse_config
 from designopt.design_space import build_chain
 from designopt.experiments.modular import catalogue_from_config, fix_modules, module_values, with_modular_cost
 from designopt.kinematics.joints import Role
-from designopt.modular import Catalogue, check_catalogue, distance, modular_cost, nearest_modules
+from designopt.modular import (
+    Catalogue,
+    check_catalogue,
+    distance,
+    modular_cost,
+    nearest_modules,
+    neighbourhood_search,
+)
 from designopt.problem import problem_from_config
 
 CAT = Catalogue("R", ((0.0, 0.5, 0.0), (0.0, 0.5, math.pi / 2), (1.0, 0.0, 0.0), (1.0, 0.5, 0.0),
@@ -112,7 +119,13 @@ def test_modular_command_writes_every_stage(tmp_path):
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "modular" / "t"
     summary = pd.read_csv(run / "summary.csv")
-    assert set(summary["case"]) == {"continuous", "continuous_modular", "rounded", "modular", "fk"}
+    stages = set(summary["case"])
+    assert {"continuous", "continuous_modular", "rounded", "modular", "fk"} <= stages
+    neighbours = {c for c in stages if c.startswith("nb-")}  # the neighbourhood search's candidates
+    assert 1 <= len(neighbours) <= 48
+    table = pd.read_csv(run / "table.csv").set_index("stage")
+    # the search starts from the rounded assignment and never ends worse than its re-solve
+    assert table.loc["neighbourhood", "design_cost"] <= table.loc["modular", "design_cost"] * (1 + 1e-9)
     assert (run / "figures" / "module_pca.png").stat().st_size > 1000
     modular_file = summary.loc[summary["case"] == "modular", "solution_file"].iloc[0]
     final = json.loads((run / modular_file).read_text())
@@ -177,4 +190,48 @@ def test_modular_study_end_to_end(tmp_path):
     enum = pd.read_csv(run / "enumeration.csv")
     assert sorted(enum["assignment"]) == ["m1 m1", "m1 m2", "m2 m1", "m2 m2"]
     assert enum["rounding_picked"].sum() == 1 and list(enum["rank"]) == [1, 2, 3, 4]
+    # the neighbourhood search ends at a local optimum of one-link changes, no worse than rounding's pick
+    cost = dict(zip(enum["assignment"], enum["design_cost"].fillna(np.inf), strict=True))  # NaN: does not track
+    picked = enum.loc[enum["neighbourhood_picked"], "assignment"].item()
+    a, b = picked.split()
+    flip = {"m1": "m2", "m2": "m1"}
+    assert cost[picked] <= min(cost[f"{flip[a]} {b}"], cost[f"{a} {flip[b]}"])
+    assert cost[picked] <= cost[enum.loc[enum["rounding_picked"], "assignment"].item()]
     assert len(pd.read_csv(run / "weight_study.csv")) == 1
+
+
+def test_neighbourhood_search_finds_the_optimum_of_a_separable_cost():
+    """A cost that is a sum over links has no local optimum but the global one under one-link changes: the
+    search finds the brute-force optimum from any start, evaluating each assignment once."""
+    rng = np.random.default_rng(7)
+    table = rng.uniform(0, 1, (4, 3))  # 4 links, 3 modules
+
+    def cost(a):
+        return float(sum(table[i, k] for i, k in enumerate(a)))
+
+    calls = []
+
+    def evaluate(batch):
+        calls.extend(batch)
+        return [cost(a) for a in batch]
+
+    truth = min(itertools.product(range(3), repeat=4), key=cost)
+    for start in [(0, 0, 0, 0), (2, 1, 0, 2)]:
+        calls.clear()
+        best, value, seen = neighbourhood_search([start], 3, evaluate, budget=81)
+        assert tuple(best) == truth and value == pytest.approx(cost(truth))
+        assert len(calls) == len(set(calls)) == len(seen)  # each assignment solved once
+
+
+def test_neighbourhood_search_keeps_its_budget_and_escapes_a_rounding_trap():
+    """A deceptive cost: the rounded start (0, 0) is a local optimum, (1, 1) the global one; with a second
+    start the search finds it; the budget caps the evaluations."""
+    costs = {(0, 0): 1.0, (0, 1): 2.0, (1, 0): 2.0, (1, 1): 0.5}
+    best, value, seen = neighbourhood_search([(0, 0)], 2, lambda b: [costs[a] for a in b], budget=10)
+    assert tuple(best) == (0, 0) and len(seen) == 3  # stuck: both neighbours are worse
+    best, value, seen = neighbourhood_search([(0, 0), (1, 0)], 2, lambda b: [costs[a] for a in b], budget=10)
+    assert tuple(best) == (1, 1) and value == 0.5
+    _, _, seen = neighbourhood_search([(0, 0, 0)], 5, lambda b: [float(sum(a)) + 1 for a in b], budget=5)
+    assert len(seen) == 5
+    nan = neighbourhood_search([(0,)], 3, lambda b: [np.nan if a == (0,) else 1.0 for a in b], budget=5)
+    assert nan[0] in ([1], [2]) and nan[1] == 1.0  # a start that does not track is left for one that does

@@ -5,6 +5,8 @@ Stages, each written to summary.csv as a ``case``:
   continuous_modular  TO with weight * L_mod added: links are pulled toward catalogue modules
   rounded             every link replaced by its nearest module, evaluated on the stage-2 trajectory
   modular             modules fixed; placement and trajectory re-solved (the modular design)
+  neighbourhood       beyond the paper: a local search over module assignments from the rounded one (one link's
+                      module changed at a time, each candidate re-solved like ``modular``; cases nb-<modules>)
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 """
 
@@ -23,13 +25,20 @@ from designopt.evaluation import evaluate
 from designopt.experiments.adapters import case_config, multistart_from_config, transcription_for, with_waypoints
 from designopt.experiments.tasks import Progress, Task, multistart_tasks, record, solve_tasks
 from designopt.kinematics.joints import Role
-from designopt.modular import Catalogue, check_catalogue, link_vectors, modular_cost, nearest_modules
+from designopt.modular import (
+    Catalogue,
+    check_catalogue,
+    link_vectors,
+    modular_cost,
+    nearest_modules,
+    neighbourhood_search,
+)
 from designopt.multistart import best_solution
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
 
-STAGES = ("continuous", "continuous_modular", "rounded", "modular", "fk")
+STAGES = ("continuous", "continuous_modular", "rounded", "modular", "neighbourhood", "fk")
 
 
 def catalogue_from_config(cfg: Config) -> Catalogue:
@@ -114,9 +123,16 @@ def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | Non
     catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
     best = {"continuous": _stage(run, base, to, settings, "continuous", progress, resume)}
     best["fk"] = _stage(run, base, transcription_for(combined_cfg, "fk"), settings, "fk", progress, resume)
-    continuous, assignment, modular = _round_and_resolve(run, base, to, settings, catalogue, cfg.modular.weight, "",
-                                                         progress, resume)
+    continuous, assignment, modular, placement = _round_and_resolve(run, base, to, settings, catalogue,
+                                                                    cfg.modular.weight, "", progress, resume)
     best["continuous_modular"], best["modular"] = continuous, modular
+    searched = assignment
+    if modular is not None and cfg.modular.neighbourhood_budget:
+        evaluate = ModuleCosts(run, base, to, settings, catalogue, placement, "nb-", progress, resume)
+        searched, _, evaluated = neighbourhood_search([tuple(assignment)], len(catalogue.modules), evaluate,
+                                                      cfg.modular.neighbourhood_budget)
+        best["neighbourhood"] = evaluate.best[tuple(searched)]
+        run.log(f"neighbourhood search: {len(evaluated)} assignments evaluated, best {[k + 1 for k in searched]}")
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
         # not a solve: derived from the stage-2 best, so it is recorded once and recomputed on resume
@@ -131,7 +147,8 @@ def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | Non
                      "tracks": bool(sol and sol.metrics.tracks),
                      "max_position_error": sol.metrics.max_position_error if sol else np.nan,
                      "max_joint_step": sol.metrics.max_joint_step if sol else np.nan,
-                     "modules": " ".join(f"m{k + 1}" for k in assignment) if stage in ("rounded", "modular") else ""})
+                     "modules": " ".join(f"m{k + 1}" for k in (searched if stage == "neighbourhood" else assignment))
+                     if stage in ("rounded", "modular", "neighbourhood") else ""})
         if sol is not None:
             write_solution(sol, run.path / f"best-{stage}.json")
     table = pd.DataFrame(rows)
@@ -150,14 +167,41 @@ def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, progress
     continuous = _stage(run, with_modular_cost(base, catalogue, weight), to, settings, f"{tag}continuous_modular",
                         progress, resume)
     if continuous is None:
-        return None, [], None
+        return None, [], None, {}
     assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)
     placed = {j.name for j in base.chain.placement_joints}
     placement = {j.name: float(v) for j, v in zip(base.chain.design, continuous.raw.q_d, strict=True)
                  if j.name in placed}
     modular = _stage(run, fix_modules(base, assignment, catalogue, placement), to, settings, f"{tag}modular",
                      progress, resume)
-    return continuous, assignment, modular
+    return continuous, assignment, modular, placement
+
+
+def _digits(assignment) -> str:
+    return "".join(str(k + 1) for k in assignment)
+
+
+class ModuleCosts:
+    """``evaluate(assignments) -> costs`` for `neighbourhood_search`: every assignment's modules-fixed problem
+    (placement and trajectory free, from the rounded stage's placement) solved like the ``modular`` stage, all
+    of a batch in one fan-out (cases ``<tag><module numbers>``); NaN when no start tracks. ``best`` keeps each
+    evaluated assignment's best solution."""
+
+    def __init__(self, run, base, to, settings, catalogue, placement, tag, progress, resume):
+        self.args = run, base, to, settings, catalogue, placement
+        self.tag, self.progress, self.resume = tag, progress, resume
+        self.best: dict[tuple[int, ...], Solution | None] = {}
+
+    def __call__(self, batch):
+        run, base, to, settings, catalogue, placement = self.args
+        tasks = []
+        for a in batch:
+            tasks += multistart_tasks(f"{self.tag}{_digits(a)}", to.name, fix_modules(base, list(a), catalogue,
+                                                                                      placement), to, settings)
+        done = solve_tasks(run, tasks, "modular", settings.jobs, self.resume, self.progress)
+        for a in batch:
+            self.best[a] = best_solution([sol for t, sol in done if t.case == f"{self.tag}{_digits(a)}"])
+        return [self.best[a].metrics.design_cost if self.best[a] is not None else np.nan for a in batch]
 
 
 @dataclass(frozen=True)
@@ -178,8 +222,8 @@ def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str
 
     weights = []
     for w in cfg.modular.weight_study:
-        cont, assignment, mod = _round_and_resolve(run, base, to, settings, catalogue, w, f"w{w:g}-", progress,
-                                                   resume)
+        cont, assignment, mod, _ = _round_and_resolve(run, base, to, settings, catalogue, w, f"w{w:g}-", progress,
+                                                      resume)
         weights.append({"weight": w, "continuous_cost": cont.metrics.design_cost if cont else np.nan,
                         "L_mod": modular_cost(base.chain, cont.raw.q_d, catalogue) if cont else np.nan,
                         "modules": " ".join(f"m{k + 1}" for k in assignment),
@@ -194,8 +238,8 @@ def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str
     small_cfg = with_waypoints(combined_cfg, n)
     small_base = problem_from_config(small_cfg, base_dir)
     small_to = transcription_for(small_cfg)
-    _, rounded_assignment, rounded_best = _round_and_resolve(run, small_base, small_to, settings, small,
-                                                             cfg.modular.weight, "enum-", progress, resume)
+    _, rounded_assignment, rounded_best, _ = _round_and_resolve(run, small_base, small_to, settings, small,
+                                                                cfg.modular.weight, "enum-", progress, resume)
     placement = {j.name: j.value for j in small_base.chain.placement_joints if j.role is Role.DESIGN}
     rows = []
     for assignment in itertools.product(range(len(subset)), repeat=small_base.chain.n_links):
@@ -206,6 +250,19 @@ def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str
                      "rounding_picked": list(assignment) == rounded_assignment})
     enum = pd.DataFrame(rows).sort_values("design_cost", na_position="last").reset_index(drop=True)
     enum["rank"] = np.arange(1, len(enum) + 1)
+    # the neighbourhood search from the rounded assignment, on the same solves (every assignment is enumerated)
+    by_assignment = {tuple(int(k) for k in a): c for a, c in zip(
+        itertools.product(range(len(subset)), repeat=small_base.chain.n_links), [r["design_cost"] for r in rows],
+        strict=True)}
+    enum["neighbourhood_picked"] = False
+    if rounded_assignment and cfg.modular.neighbourhood_budget:
+        found, _, evaluated = neighbourhood_search([tuple(rounded_assignment)], len(subset),
+                                                   lambda batch: [by_assignment[a] for a in batch],
+                                                   cfg.modular.neighbourhood_budget)
+        label = " ".join(f"m{subset[k] + 1}" for k in found)
+        enum["neighbourhood_picked"] = enum["assignment"] == label
+        run.log(f"neighbourhood search from the rounded assignment: {label} after {len(evaluated)} of "
+                f"{len(enum)} assignments, rank {int(enum.loc[enum['neighbourhood_picked'], 'rank'].iloc[0])}")
     enum.to_csv(run.path / "enumeration.csv", index=False)
     run.log(f"rounding picked {rounded_assignment}, its re-solve cost "
             f"{rounded_best.metrics.design_cost if rounded_best else float('nan')}")
