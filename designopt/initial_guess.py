@@ -131,13 +131,19 @@ def _residual_function(problem: DesignProblem):
     return ca.Function("reach", [q, q_d, s_W], [r, ca.jacobian(r, q), ca.jacobian(r, q_d)])
 
 
-def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik") -> InitialGuess:
+def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik",
+                  design: np.ndarray | None = None) -> InitialGuess:
     """Start ``index`` of a seeded multistart (seed * 1000 + index). Start 0 keeps the configured design;
-    the others perturb it. Each start depends only on (seed, index), so starts can be made in any order."""
+    the others perturb it; ``design`` (if given) is the start design instead. Each start depends only on
+    (seed, index), so starts can be made in any order."""
     if mode not in INIT_MODES:
         raise ValueError(f"init must be one of {INIT_MODES}, got {mode!r}")
     rng = np.random.default_rng([seed, index])
-    q_d = problem.chain.design_values if index == 0 else perturbed_design(problem, rng, scale)
+    if design is not None:
+        q_d = np.clip(np.asarray(design, float), [j.lower for j in problem.chain.design],
+                      [j.upper for j in problem.chain.design])
+    else:
+        q_d = problem.chain.design_values if index == 0 else perturbed_design(problem, rng, scale)
     q0 = random_configuration(problem, rng)
     if mode == "constant":
         return InitialGuess(q_d=q_d, Q=np.tile(q0, (problem.toolpath.n, 1)), seed=seed * 1000 + index)
@@ -151,6 +157,14 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
         if not tracks(problem, q_d, Q):
             q_d, Q = reach(problem, q_d, Q)
     return InitialGuess(q_d=q_d, Q=Q, seed=seed * 1000 + index)
+
+
+def design_from(problem: DesignProblem, other: DesignProblem, q_d_other: np.ndarray) -> np.ndarray:
+    """``problem``'s design joints with the values another problem's design ``q_d_other`` gives the joints of the
+    same name (e.g. a neighbouring structure's placement and link lengths); the others keep their configured
+    values."""
+    given = {j.name: float(v) for j, v in zip(other.chain.design, q_d_other, strict=True)}
+    return np.array([given.get(j.name, j.value) for j in problem.chain.design])
 
 
 def tracks(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> bool:

@@ -48,9 +48,10 @@ def solve_guess(problem: DesignProblem, transcription, guess: InitialGuess, labe
     return solve_and_evaluate(problem, transcription.name, nlp.solve(guess), label)
 
 
-def solve_start(problem: DesignProblem, transcription, settings: Multistart, index: int, label: str = "") -> Solution:
-    """Build (or reuse) the NLP and solve start ``index`` of the multistart."""
-    guess = initial_guess(problem, index, settings.seed, settings.scale, settings.init)
+def solve_start(problem: DesignProblem, transcription, settings: Multistart, index: int, label: str = "",
+                design=None) -> Solution:
+    """Build (or reuse) the NLP and solve start ``index`` of the multistart (from ``design`` if given)."""
+    guess = initial_guess(problem, index, settings.seed, settings.scale, settings.init, design)
     return solve_guess(problem, transcription, guess, label)
 
 

@@ -10,13 +10,14 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
 from typer.testing import CliRunner
 
 from cli.main import app
-from designopt.experiments.sweep import enumerate_structures
+from designopt.experiments.sweep import enumerate_structures, neighbours
 from designopt.verify import verify_file
 
 runner = CliRunner()
@@ -30,6 +31,29 @@ def test_enumeration_count_and_order():
     assert all6[:6] == ["R", "P", "RR", "RP", "PR", "PP"]
     assert enumerate_structures(6, 6)[0] == "RRRRRR" and enumerate_structures(6, 6)[-1] == "PPPPPP"
     assert sum(s.count("P") == 3 for s in enumerate_structures(6, 6)) == 20
+
+
+def test_neighbours_differ_in_one_joint_type():
+    structures = enumerate_structures(1, 3)
+    assert sorted(neighbours("RRP", structures)) == ["PRP", "RPP", "RRR"]
+    assert neighbours("R", structures) == ["P"]
+    assert all(len(neighbours(s, structures)) == len(s) for s in structures)
+
+
+def test_a_neighbours_design_starts_the_joints_of_the_same_name():
+    from designopt.config import parse_config
+    from designopt.initial_guess import design_from
+    from designopt.problem import problem_from_config
+
+    base = {"robot": {"dh": "generic", "design": ["d", "a", "alpha"]}}
+    rr = problem_from_config(parse_config({**base, "robot": {**base["robot"], "structure": "RRRRRR"}}))
+    pr = problem_from_config(parse_config({**base, "robot": {**base["robot"], "structure": "PRRRRR"}}))
+    q = np.linspace(0.1, 0.9, rr.chain.n_design)
+    mapped = design_from(pr, rr, q)
+    given = dict(zip([j.name for j in rr.chain.design], q, strict=True))
+    for j, v in zip(pr.chain.design, mapped, strict=True):
+        assert v == (given[j.name] if j.name in given else j.value), j.name
+    assert "link1.theta" in {j.name for j in pr.chain.design} and "link1.d" not in {j.name for j in pr.chain.design}
 
 
 def small_config(tmp_path, **solver) -> Path:
@@ -62,6 +86,14 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
     stages = summary.groupby(["structure", "case"]).size()
     for s in ("RR", "RP", "PR", "PP"):  # every structure gets the same search: 3 coarse starts, the best refined
         assert stages[s, "sweep-explore"] == 3 and stages.get((s, "sweep-refine"), 0) <= 1
+    # a structure gets a neighbour-seeded start exactly when a neighbour (one joint type changed) searched its
+    # way to a cheaper design than its own
+    refined = summary[summary["case"] == "sweep-refine"]
+    best = refined[refined["tracks"]].groupby("structure")["design_cost"].min()
+    seeded = set(summary.loc[summary["case"] == "sweep-neighbour", "structure"])
+    for s in best.index:
+        better = [n for n in neighbours(s, list(best.index)) if best[n] < best[s]]
+        assert (s in seeded) == bool(better), s
     assert "6 structures solved" in result.output
     table = pd.read_csv(run / "table.csv")
     assert list(table["structure"]) == ["R", "P", "RR", "RP", "PR", "PP"]

@@ -23,7 +23,8 @@ from designopt.experiments.adapters import (
     structure_config,
     transcription_for,
 )
-from designopt.experiments.tasks import Progress, Searchable, search_problems
+from designopt.experiments.tasks import Progress, Searchable, Searched, Task, best_of, search_problems, solve_tasks
+from designopt.initial_guess import design_from
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.tables import best_per_dof, structure_table
@@ -36,6 +37,31 @@ def searchables(cfg: Config, base_dir: Path, structures: list[str]) -> list[Sear
         c = structure_config(cfg, structure)
         items.append(Searchable("sweep", problem_from_config(c, base_dir), transcription_for(c)))
     return items
+
+
+def neighbours(structure: str, structures: list[str]) -> list[str]:
+    """The structures among ``structures`` that differ from ``structure`` in one joint's type (R <-> P)."""
+    return [s for s in structures
+            if len(s) == len(structure) and sum(a != b for a, b in zip(s, structure, strict=True)) == 1]
+
+
+def neighbour_tasks(items: list[Searchable], searched: list[Searched], settings) -> list[Task]:
+    """One start per (structure, neighbouring structure that has a better design): the neighbour's best design
+    (placement and every link parameter of the same name) as the start design, on the full path. A structure
+    whose neighbour found a cheaper design was stuck in a worse basin, and the neighbour's design is a good
+    guess for it: the two differ in one joint's type only."""
+    best = {it.problem.chain.structure: (it, best_of(s.final)[1]) for it, s in zip(items, searched, strict=True)}
+    structures = list(best)
+    tasks = []
+    for it, s in zip(items, searched, strict=True):
+        own = best_of(s.final)[1]
+        for j, other in enumerate(neighbours(it.problem.chain.structure, structures)):
+            theirs = best[other][1]
+            if theirs is None or (own is not None and theirs.metrics.design_cost >= own.metrics.design_cost):
+                continue
+            design = design_from(it.problem, best[other][0].problem, theirs.raw.q_d)
+            tasks.append(Task(f"{it.case}-neighbour", "to", it.problem, it.transcription, settings, j, design=design))
+    return tasks
 
 
 @contextmanager
@@ -90,10 +116,14 @@ def run_sweep(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None,
     before = len(run.resume()) if resume else 0
     run.log(f"sweep {min_dof}..{max_dof} DOF: {len(structures)} structures, search {describe_search(cfg)}; "
             f"{before} solves already done")
+    items, settings = searchables(cfg, base_dir, structures), multistart_from_config(cfg)
     with backend(backend_name, scheduler, jobs):
         # every structure gets the same search, stage by stage across all of them (workers stay busy)
-        search_problems(run, searchables(cfg, base_dir, structures), multistart_from_config(cfg),
-                        search_from_config(cfg), cfg.name, jobs=None, resume=resume, progress=progress)
+        searched = search_problems(run, items, settings, search_from_config(cfg), cfg.name, jobs=None, resume=resume,
+                                   progress=progress)
+        if cfg.solver.search.structure_neighbours:
+            solve_tasks(run, neighbour_tasks(items, searched, settings), cfg.name, jobs=None, resume=resume,
+                        progress=progress)
     after = len(pd.read_csv(run.summary))
     summary = pd.read_csv(run.summary)
     table = structure_table(summary)

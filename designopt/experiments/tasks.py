@@ -13,6 +13,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, replace
 from typing import Protocol
 
+import numpy as np
+
 from designopt.multistart import Multistart, best_solution, solve_guess, solve_start
 from designopt.problem import DesignProblem
 from designopt.results_io import RunDirectory
@@ -23,7 +25,8 @@ from designopt.solution import Solution, SolutionLoadError, read_solution_for, w
 @dataclass(frozen=True)
 class Task:
     """Start ``index`` of a seeded multistart of ``problem`` with ``transcription``, labelled ``case``; with
-    ``warm``, the start is that solution (of another sampling of the same task) lifted to ``problem``."""
+    ``warm``, the start is that solution (of another sampling of the same task) lifted to ``problem``; with
+    ``design``, the start's design is that one."""
 
     case: str
     method: str
@@ -32,6 +35,7 @@ class Task:
     settings: Multistart
     index: int
     warm: Solution | None = None
+    design: np.ndarray | None = None  # a start design (IK-initialised like every start) instead of the seeded one
 
     @property
     def seed(self) -> int:
@@ -75,7 +79,7 @@ def multistart_tasks(case: str, method: str, problem: DesignProblem, transcripti
 def _solve(task: Task) -> tuple[Task, Solution]:
     if task.warm is not None:
         return task, solve_guess(task.problem, task.transcription, lifted_guess(task.problem, task.warm), task.case)
-    return task, solve_start(task.problem, task.transcription, task.settings, task.index, task.case)
+    return task, solve_start(task.problem, task.transcription, task.settings, task.index, task.case, task.design)
 
 
 def fan_out(tasks: list[Task], jobs: int | None) -> Iterator[tuple[Task, Solution]]:
