@@ -122,7 +122,7 @@ def test_modular_command_writes_every_stage(tmp_path):
     stages = set(summary["case"])
     assert {"continuous", "continuous_modular", "rounded", "modular", "fk"} <= stages
     neighbours = {c for c in stages if c.startswith("nb-")}  # the neighbourhood search's candidates
-    assert 1 <= len(neighbours) <= 48
+    assert 1 <= len(neighbours) <= 47  # the rounded assignment itself is the modular stage
     table = pd.read_csv(run / "table.csv").set_index("stage")
     # the search starts from the rounded assignment and never ends worse than its re-solve
     assert table.loc["neighbourhood", "design_cost"] <= table.loc["modular", "design_cost"] * (1 + 1e-9)

@@ -129,6 +129,7 @@ def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | Non
     searched = assignment
     if modular is not None and cfg.modular.neighbourhood_budget:
         evaluate = ModuleCosts(run, base, to, settings, catalogue, placement, "nb-", progress, resume)
+        evaluate.best[tuple(assignment)] = modular  # the start is the modular stage, already solved
         searched, _, evaluated = neighbourhood_search([tuple(assignment)], len(catalogue.modules), evaluate,
                                                       cfg.modular.neighbourhood_budget)
         best["neighbourhood"] = evaluate.best[tuple(searched)]
@@ -195,11 +196,11 @@ class ModuleCosts:
     def __call__(self, batch):
         run, base, to, settings, catalogue, placement = self.args
         tasks = []
-        for a in batch:
+        for a in (a for a in batch if a not in self.best):  # known: the rounded assignment's re-solve
             tasks += multistart_tasks(f"{self.tag}{_digits(a)}", to.name, fix_modules(base, list(a), catalogue,
                                                                                       placement), to, settings)
         done = solve_tasks(run, tasks, "modular", settings.jobs, self.resume, self.progress)
-        for a in batch:
+        for a in (a for a in batch if a not in self.best):
             self.best[a] = best_solution([sol for t, sol in done if t.case == f"{self.tag}{_digits(a)}"])
         return [self.best[a].metrics.design_cost if self.best[a] is not None else np.nan for a in batch]
 
