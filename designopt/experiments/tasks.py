@@ -166,9 +166,10 @@ class Searchable:
     transcription: object
 
 
-def _by_problem(items: list[Searchable], done: list[tuple[Task, Solution]], stage: str) -> list[list]:
+def _by_problem(items: list[Searchable], done: list[tuple[Task, Solution]], stage: str | None = None) -> list[list]:
     """Split one stage's (task, solution) pairs by the problem they belong to, each list in start order."""
-    where = {(_stage(it.case, stage), it.problem.chain.structure): k for k, it in enumerate(items)}
+    where = {(_stage(it.case, stage) if stage else it.case, it.problem.chain.structure): k
+             for k, it in enumerate(items)}
     out = [[] for _ in items]
     for task, sol in done:
         out[where[task.case, task.problem.chain.structure]].append((task, sol))
@@ -196,11 +197,7 @@ def search_problems(run: RunDirectory, items: list[Searchable], settings: Multis
     if search.strategy == "multistart":
         tasks = [t for it in items for t in multistart_tasks(it.case, "to", it.problem, it.transcription, settings)]
         done = solve_tasks(run, tasks, experiment, jobs, resume, progress)
-        where = {(it.case, it.problem.chain.structure): k for k, it in enumerate(items)}
-        final = [[] for _ in items]
-        for task, sol in done:
-            final[where[task.case, task.problem.chain.structure]].append((task, sol))
-        return [Searched([], sorted(f, key=lambda d: d[0].index)) for f in final]
+        return [Searched([], f) for f in _by_problem(items, done)]
     explore = [t for it in items for t in multistart_tasks(
         _stage(it.case, "explore"), "to", coarse_problem(it.problem, search.explore_waypoints),
         replace(it.transcription, max_iter=search.explore_max_iter), replace(settings, count=search.explore_starts))]
