@@ -4,7 +4,7 @@ Local optima are everywhere in design problems: the same task solved from 48 see
 between the best design known and 2,000 times its cost, and a start's objective after a few hundred IPOPT
 iterations barely predicts where it ends (docs/benchmarks.md, "Racing starts"). What does predict it is the
 same problem solved on fewer waypoints: a design optimal for a coarse sampling of the path lies, more often
-than not, in the basin of a design optimal for the full path. So the default search has two stages:
+than not, in the basin of a design optimal for the full path. So the default search has three stages:
 
 1. **explore**: ``explore_starts`` cold, seeded starts (`designopt.initial_guess`) of the *coarse problem* --
    the same robot, placement, costs and cell on ``explore_waypoints`` of the path's waypoints
@@ -49,9 +49,9 @@ class Search:
     explore_starts: int = 80
     explore_max_iter: int = 250
     refine: int = 4
-    distinct: float = 0.02
+    distinct: float = 0.02  # m or rad: optima closer than this in every design joint are one optimum
     screen_waypoints: int = 40  # re-rank the best ``screen`` coarse optima on this many waypoints first (0: don't)
-    screen: int = 12  # m or rad: coarse optima closer than this in every design joint are one optimum
+    screen: int = 12
 
     def __post_init__(self):
         if self.strategy not in STRATEGIES:

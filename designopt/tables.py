@@ -8,7 +8,7 @@ import pandas as pd
 
 from designopt.design_space import enumerate_structures
 from designopt.multistart import best_solution
-from designopt.search import cluster_designs, design_distance  # noqa: F401  (tables name them too)
+from designopt.search import cluster_designs
 
 CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
 

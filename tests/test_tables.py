@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from designopt.tables import best_so_far, cluster_designs, design_distance
+from designopt.search import cluster_designs, design_distance
+from designopt.tables import best_so_far
 
 
 def test_design_distance_wraps_angles():
