@@ -195,6 +195,7 @@ class SearchConfig(_Strict):
     distinct: Annotated[float, Field(gt=0)] = 0.02  # m or rad
     screen_waypoints: Annotated[int, Field(ge=0, le=5000)] = 40  # 0 (or >= the path's waypoints): no screening
     screen: Annotated[int, Field(ge=1, le=1000)] = 12
+    screen_max_iter: Annotated[int, Field(ge=1, le=1_000_000)] = 300
     # sweep only: one more start per structure from each neighbouring structure's (one joint type changed) better
     # design
     structure_neighbours: bool = True

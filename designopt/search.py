@@ -12,7 +12,8 @@ than not, in the basin of a design optimal for the full path. So the default sea
    a tenth of a full one, so the same budget visits ten times as many basins.
 2. **screen** (when ``screen_waypoints`` is between 0 and the path's waypoints): the ``screen`` best distinct
    coarse optima are lifted to a finer sampling (``screen_waypoints``) and solved warm, and ranked again there:
-   the 10-waypoint ranking alone often puts a design that lifts badly ahead of one that lifts well.
+   the 10-waypoint ranking alone often puts a design that lifts badly ahead of one that lifts well. Each is
+   capped at ``screen_max_iter`` iterations: it only has to rank.
 3. **refine**: the ``refine`` best *distinct* screened (or coarse) optima (designs further apart than
    ``distinct`` in some design joint: `cluster_designs`) are lifted to the full path -- design as is,
    trajectory sampled from the coarser cubic (`lifted_guess`) -- and solved warm: IPOPT's barrier starts
@@ -52,6 +53,7 @@ class Search:
     distinct: float = 0.02  # m or rad: optima closer than this in every design joint are one optimum
     screen_waypoints: int = 40  # re-rank the best ``screen`` coarse optima on this many waypoints first (0: don't)
     screen: int = 12
+    screen_max_iter: int = 300  # a screening solve ranks; it need not converge (design-only stalls there)
 
     def __post_init__(self):
         if self.strategy not in STRATEGIES:

@@ -123,3 +123,21 @@ def test_the_search_finds_the_optimum_a_single_start_misses(milling_12, tmp_path
     assert result.best is not None and result.best.metrics.tracks
     assert result.best.metrics.design_cost <= known * 1.001  # at least as good as the grid's best
     assert len(result.explored) == 8 and 1 <= len(result.solutions) <= 2
+
+
+def test_each_stage_keeps_its_own_iteration_cap(milling_12, tmp_path):
+    """Exploration within explore_max_iter, screening within screen_max_iter, refinement within solver.max_iter:
+    a screening solve only ranks, so a stalling one must not take the full budget (design only stalls there)."""
+    import pandas as pd
+
+    cfg = copy.deepcopy(milling_12)
+    cfg["solver"]["search"] = {"explore_starts": 4, "explore_waypoints": 6, "explore_max_iter": 100,
+                               "screen_waypoints": 9, "screen": 3, "screen_max_iter": 25, "refine": 1}
+    result = run_experiment(parse_config(cfg), ROOT / "configs", tmp_path, "s", figures=False)
+    rows = pd.read_csv(result.directory.path / "summary.csv")
+    caps = {"explore": 100, "screen": 25, "refine": 300}
+    assert set(rows.case) == set(caps)
+    for stage, cap in caps.items():
+        assert rows[rows.case == stage].iterations.max() <= cap
+    assert rows[rows.case == "screen"].iterations.max() == 25  # 25 iterations do not converge on a finer path
+    assert rows[rows.case == "refine"].iterations.max() > 25

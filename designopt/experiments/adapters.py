@@ -34,7 +34,7 @@ def search_from_config(cfg: Config) -> Search:
     s = cfg.solver.search
     return Search(strategy=s.strategy, explore_waypoints=s.explore_waypoints, explore_starts=s.explore_starts,
                   explore_max_iter=s.explore_max_iter, refine=s.refine, distinct=s.distinct,
-                  screen_waypoints=s.screen_waypoints, screen=s.screen)
+                  screen_waypoints=s.screen_waypoints, screen=s.screen, screen_max_iter=s.screen_max_iter)
 
 
 def describe_search(cfg: Config) -> str:
@@ -42,7 +42,8 @@ def describe_search(cfg: Config) -> str:
     s = cfg.solver.search
     if s.strategy == "multistart":
         return f"multistart, {cfg.solver.multistart} starts"
-    screen = (f", the best {s.screen} distinct re-ranked on {s.screen_waypoints} waypoints (if the path has more)"
+    screen = (f", the best {s.screen} distinct re-ranked on {s.screen_waypoints} waypoints (<= {s.screen_max_iter} "
+              f"iterations, if the path has more)"
               if s.screen_waypoints else "")
     return (f"coarse to fine: {s.explore_starts} starts on {s.explore_waypoints} waypoints (<= {s.explore_max_iter} "
             f"iterations){screen}, the best {s.refine} distinct optima refined on the full path")

@@ -177,12 +177,15 @@ def _by_problem(items: list[Searchable], done: list[tuple[Task, Solution]], stag
 
 
 def _lifted_tasks(items: list[Searchable], found: list[list], count: int, stage: str, waypoints: int | None,
-                  settings: Multistart, search: Search) -> list[Task]:
-    """For every problem, its ``count`` best distinct solutions lifted to ``waypoints`` (None: the full path)."""
+                  settings: Multistart, search: Search, max_iter: int | None = None) -> list[Task]:
+    """For every problem, its ``count`` best distinct solutions lifted to ``waypoints`` (None: the full path),
+    each solved warm within ``max_iter`` iterations (None: the transcription's own cap)."""
     tasks = []
     for it, done in zip(items, found, strict=True):
         problem = it.problem if waypoints is None else coarse_problem(it.problem, waypoints)
         warm = replace(it.transcription, ipopt={**it.transcription.ipopt, **WARM_IPOPT})
+        if max_iter is not None:
+            warm = replace(warm, max_iter=min(max_iter, warm.max_iter))
         for i in distinct_best([sol for _, sol in done], count, search.distinct):
             tasks.append(Task(_stage(it.case, stage), "to", problem, warm, settings, done[i][0].index, done[i][1]))
     return tasks
@@ -208,7 +211,7 @@ def search_problems(run: RunDirectory, items: list[Searchable], settings: Multis
         # rank the best distinct coarse optima again on a finer (still cheap) sampling before the full path
         sub = [items[k] for k in screened]
         tasks = _lifted_tasks(sub, [explored[k] for k in screened], search.screen, "screen", search.screen_waypoints,
-                              settings, search)
+                              settings, search, search.screen_max_iter)
         found = dict(zip(screened, _by_problem(sub, solve_tasks(run, tasks, experiment, jobs, resume, progress),
                                                 "screen"), strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(items))]
