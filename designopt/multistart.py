@@ -12,7 +12,7 @@ import functools
 import hashlib
 import os
 import pickle
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from designopt.initial_guess import initial_guess
 from designopt.problem import DesignProblem
@@ -42,10 +42,15 @@ def _built(key: str, payload: bytes):
 
 
 def solve_guess(problem: DesignProblem, transcription, guess: InitialGuess, label: str = "") -> Solution:
-    """Build (or reuse) the NLP and solve it from ``guess``."""
+    """Build (or reuse) the NLP and solve it from ``guess``. The result's ``build_time_s`` is the time this call
+    spent building: 0 when the worker reused an NLP it had built for an earlier start."""
     payload = pickle.dumps((problem, transcription))
+    misses = _built.cache_info().misses
     nlp = _built(hashlib.sha256(payload).hexdigest(), payload)
-    return solve_and_evaluate(problem, transcription.name, nlp.solve(guess), label)
+    raw = nlp.solve(guess)
+    if _built.cache_info().misses == misses:
+        raw = replace(raw, build_time_s=0.0)
+    return solve_and_evaluate(problem, transcription.name, raw, label)
 
 
 def solve_start(problem: DesignProblem, transcription, settings: Multistart, index: int, label: str = "",

@@ -96,6 +96,8 @@ MUTATIONS = [
              "for k in np.argsort(costs, kind=\"stable\"):", "for k in np.argsort(-costs, kind=\"stable\"):"),
     Mutation("lifted start drops the coarse design", "designopt/search.py",
              "q_d=np.asarray(solution.raw.q_d, float)", "q_d=problem.chain.design_values"),
+    Mutation("screening ignores its iteration cap", "designopt/experiments/tasks.py",
+             "settings, search, search.screen_max_iter)", "settings, search)"),
 ]
 
 

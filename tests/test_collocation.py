@@ -157,3 +157,16 @@ def test_reach_moves_the_design_joints_until_the_start_reaches_the_path():
     # start 0 already tracks: reach leaves it exactly as it was
     a, b = initial_guess(problem, 0, 0, 0.3, "ik"), initial_guess(problem, 0, 0, 0.3, "reach")
     np.testing.assert_array_equal(a.Q, b.Q)
+
+
+def test_build_time_is_counted_once_per_built_nlp():
+    """A worker builds a problem's NLP for its first start and reuses it: only that start reports a build time
+    (summing build_time_s over a sweep must give the time spent building)."""
+    from designopt.multistart import Multistart, solve_start
+
+    # a force no other test uses, so that this problem is not in the worker's cache yet
+    problem = problem_from_config(parse_config(gantry_config(toolpath={"force": 2.718281828})))
+    transcription, settings = Collocation(max_iter=50), Multistart(count=2, init="constant")
+    first, second = (solve_start(problem, transcription, settings, i) for i in range(2))
+    assert first.raw.build_time_s > 0
+    assert second.raw.build_time_s == 0
