@@ -28,8 +28,13 @@ def perturbed_design(problem: DesignProblem, rng: np.random.Generator, scale: fl
     joints = problem.chain.design
     noise = rng.uniform(-1.0, 1.0, len(joints))
     step = np.array([0.5 if j.kind == "length" else np.pi for j in joints]) * scale
-    values = np.array([j.value for j in joints]) + noise * step
-    return np.clip(values, [j.lower for j in joints], [j.upper for j in joints])
+    return within_bounds(problem, np.array([j.value for j in joints]) + noise * step)
+
+
+def within_bounds(problem: DesignProblem, q_d: np.ndarray) -> np.ndarray:
+    """Design joint values clipped to their bounds."""
+    joints = problem.chain.design
+    return np.clip(np.asarray(q_d, float), [j.lower for j in joints], [j.upper for j in joints])
 
 
 def random_configuration(problem: DesignProblem, rng: np.random.Generator) -> np.ndarray:
@@ -140,8 +145,7 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
         raise ValueError(f"init must be one of {INIT_MODES}, got {mode!r}")
     rng = np.random.default_rng([seed, index])
     if design is not None:
-        q_d = np.clip(np.asarray(design, float), [j.lower for j in problem.chain.design],
-                      [j.upper for j in problem.chain.design])
+        q_d = within_bounds(problem, design)
     else:
         q_d = problem.chain.design_values if index == 0 else perturbed_design(problem, rng, scale)
     q0 = random_configuration(problem, rng)

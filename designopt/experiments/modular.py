@@ -195,12 +195,13 @@ class ModuleCosts:
 
     def __call__(self, batch):
         run, base, to, settings, catalogue, placement = self.args
+        todo = [a for a in batch if a not in self.best]  # known already: e.g. the rounded assignment's re-solve
         tasks = []
-        for a in (a for a in batch if a not in self.best):  # known: the rounded assignment's re-solve
+        for a in todo:
             tasks += multistart_tasks(f"{self.tag}{_digits(a)}", to.name, fix_modules(base, list(a), catalogue,
                                                                                       placement), to, settings)
         done = solve_tasks(run, tasks, "modular", settings.jobs, self.resume, self.progress)
-        for a in (a for a in batch if a not in self.best):
+        for a in todo:
             self.best[a] = best_solution([sol for t, sol in done if t.case == f"{self.tag}{_digits(a)}"])
         return [self.best[a].metrics.design_cost if self.best[a] is not None else np.nan for a in batch]
 

@@ -53,8 +53,8 @@ def neighbour_tasks(items: list[Searchable], searched: list[Searched], settings)
     best = {it.problem.chain.structure: (it, best_of(s.final)[1]) for it, s in zip(items, searched, strict=True)}
     structures = list(best)
     tasks = []
-    for it, s in zip(items, searched, strict=True):
-        own = best_of(s.final)[1]
+    for it in items:
+        own = best[it.problem.chain.structure][1]
         for j, other in enumerate(neighbours(it.problem.chain.structure, structures)):
             theirs = best[other][1]
             if theirs is None or (own is not None and theirs.metrics.design_cost >= own.metrics.design_cost):
