@@ -214,6 +214,9 @@ class SolverConfig(_Strict):
     init: Literal["reach", "ik", "constant"] = "ik"
     compile: Literal["none", "O0", "O1", "O2"] = "O0"
     time_limit: Positive = 300.0
+    # a TO solve that stalls on a design whose joint axes are all parallel to the workpiece normal is finished
+    # with those design angles held (designopt.transcriptions.degeneracy; README "Degenerate designs")
+    hold_degenerate: bool = True
     search: SearchConfig = SearchConfig()
 
 

@@ -20,7 +20,7 @@ SUMMARY_COLUMNS = [
     "experiment", "case", "method", "structure", "dof", "n_prismatic", "n_design_joints",
     "design_cost", "max_position_error", "max_axis_error", "max_joint_step", "tracks", "best",
     "status", "success", "iterations", "solve_time_s", "build_time_s", "n_variables", "n_constraints",
-    "objective", "regularization", "min_standoff", "kinematic_drift", "seed",
+    "objective", "regularization", "min_standoff", "kinematic_drift", "held", "seed",
     "stiffness_revolute", "stiffness_prismatic", "deflection", "min_clearance", "clearance_link",
     "clearance_obstacle", "solution_file",
 ]

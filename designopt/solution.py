@@ -133,6 +133,7 @@ class Solution:
             "n_constraints": r.n_constraints,
             "objective": r.objective,
             "kinematic_drift": r.kinematic_drift,
+            "held": r.held,
             "seed": r.seed,
             "stiffness_revolute": self.problem.stiffness.by_type()[0],
             "stiffness_prismatic": self.problem.stiffness.by_type()[1],
@@ -238,6 +239,7 @@ def to_dict(sol: Solution) -> dict:
             **({"clearance": {"min": m.clearance.value, "link": m.clearance.link, "obstacle": m.clearance.obstacle,
                               "time_index": m.clearance.time_index}} if m.clearance is not None else {}),
             "kinematic_drift": r.kinematic_drift,
+            **({"held": r.held} if r.held else {}),
             "objective": _finite(r.objective),
             "success": r.success,
             "build_time_s": r.build_time_s,
@@ -303,7 +305,8 @@ def _raw_from_file(data: dict, q_d: np.ndarray) -> RawResult:
                      build_time_s=float(m.get("build_time_s", 0.0)),
                      objective=float("nan") if objective is None else float(objective),
                      n_variables=int(m.get("n_variables", 0)), n_constraints=int(m.get("n_constraints", 0)),
-                     seed=int(m.get("seed", 0)), kinematic_drift=float(m.get("kinematic_drift", 0.0)))
+                     seed=int(m.get("seed", 0)), kinematic_drift=float(m.get("kinematic_drift", 0.0)),
+                     held=str(m.get("held", "")))
 
 
 def chain_from_file(data: dict) -> Chain:

@@ -23,7 +23,8 @@ ROOT = Path(__file__).resolve().parent.parent
 # The tests that guard the objective; each mutation runs them with -x (stop at the first failure).
 TESTS = ["tests/test_objective_truth.py", "tests/test_costs_and_toolpaths.py", "tests/test_kinematics.py",
          "tests/test_collocation.py", "tests/test_fk.py", "tests/test_cli_and_files.py", "tests/test_urdf.py",
-         "tests/test_gcode.py", "tests/test_forces.py", "tests/test_clearance.py", "tests/test_search.py"]
+         "tests/test_gcode.py", "tests/test_forces.py", "tests/test_clearance.py", "tests/test_search.py",
+         "tests/test_degeneracy.py"]
 
 
 @dataclass(frozen=True)
@@ -98,6 +99,12 @@ MUTATIONS = [
              "q_d=np.asarray(solution.raw.q_d, float)", "q_d=problem.chain.design_values"),
     Mutation("screening ignores its iteration cap", "designopt/experiments/tasks.py",
              "settings, search, search.screen_max_iter)", "settings, search)"),
+    # degenerate designs (issue 12, cause 3)
+    Mutation("a moving target's row held once", "designopt/transcriptions/degeneracy.py",
+             "if i in POSITION_ROWS and np.ptp(tp.points_W[tracked, i]) > 1e-12:",
+             "if i in POSITION_ROWS and np.ptp(tp.points_W[tracked, i]) > 1e12:"),
+    Mutation("a stalled solve is continued without holding its angles", "designopt/multistart.py",
+             "more = _solve_built(held_problem, warm,", "more = _solve_built(problem, warm,"),
 ]
 
 

@@ -21,7 +21,7 @@ def transcription_for(cfg: Config, method: str = "to"):
     s = cfg.solver
     options = {"max_iter": s.max_iter, "compile": s.compile, "ipopt": {"ipopt.max_wall_time": float(s.time_limit)}}
     if method == "to":
-        options.update(kinematics=s.kinematics, tracking=s.tracking, degree=s.degree)
+        options.update(kinematics=s.kinematics, tracking=s.tracking, degree=s.degree, hold_degenerate=s.hold_degenerate)
     return transcription_named(method, **options)
 
 

@@ -33,7 +33,8 @@ class Transcription(Protocol):
 # The one registry: method name -> (factory, the options it takes).
 _FK_OPTIONS = ("max_iter", "compile", "ipopt", "epsilon", "hessian")
 TRANSCRIPTIONS = {
-    "to": (Collocation, ("kinematics", "tracking", "degree", "max_iter", "hessian", "compile", "ipopt")),
+    "to": (Collocation, ("kinematics", "tracking", "degree", "max_iter", "hessian", "compile", "ipopt",
+                        "hold_degenerate")),
     "fk": (lambda **o: ForwardKinematics(continuous=False, **o), _FK_OPTIONS),
     "fk_continuous": (lambda **o: ForwardKinematics(continuous=True, **o), _FK_OPTIONS),
 }

@@ -37,6 +37,7 @@ class RawResult:
     n_constraints: int
     seed: int = 0
     kinematic_drift: float = 0.0
+    held: str = ""  # design joints held on a degenerate design to finish the solve (transcriptions.degeneracy)
 
 
 def waypoint_function(problem: DesignProblem) -> ca.Function:

@@ -23,6 +23,7 @@ import numpy as np
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess, RawResult, waypoint_function
 from designopt.transcriptions.compiled import COMPILE_MODES
+from designopt.transcriptions.degeneracy import DegenerateWatch
 from designopt.transcriptions.nlp import (
     BlockStructure,
     ConstraintList,
@@ -70,6 +71,7 @@ class Collocation:
     hessian: str = "structured"
     compile: str = "O0"
     ipopt: dict = field(default_factory=dict)
+    hold_degenerate: bool = True  # finish a stalled solve on a degenerate design with its angles held (multistart)
 
     name = "to"
 
@@ -128,7 +130,8 @@ class CollocationNLP:
         n_c = C.shape[0]
         C_lo, C_hi = np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N))
         once = once_only_rows(problem, scheme.tracking) if not differential else np.zeros(0, dtype=int)
-        C_lo[once, 1:], C_hi[once, 1:] = -np.inf, np.inf
+        others = np.arange(N) != int(np.argmax(tp.is_tracked))  # held at the first tracked waypoint only
+        C_lo[np.ix_(once, others)], C_hi[np.ix_(once, others)] = -np.inf, np.inf
         C_lo, C_hi = free_untracked(problem, C_lo, C_hi,
                                     tracking_rows(problem, scheme.tracking, position_in_terms=not differential))
         cons.add(C, C_lo, C_hi)  # first, so that its multipliers are 0 .. n_c N
@@ -186,8 +189,11 @@ class CollocationNLP:
                                      scheme.compile), *cell_blocks]
         elif problem.cell is not None:
             raise ValueError("clearance constraints need the structured Hessian and forward kinematics")
+        watch = None
+        if scheme.hold_degenerate and scheme.tracking == "hard" and not differential:
+            watch = DegenerateWatch(problem, x.shape[0], cons.size)
         self.nlp = WaypointNLP(problem, "to", x, objective, quadratic, cons, lbx, ubx, blocks, scheme.max_iter,
-                               scheme.ipopt, t0)
+                               scheme.ipopt, t0, watch)
         self.solver, self.lbx, self.ubx = self.nlp.solver, self.nlp.lbx, self.nlp.ubx
         self.n_variables, self.n_constraints = self.nlp.n_variables, self.nlp.n_constraints
         self.build_time_s = self.nlp.build_time_s

@@ -15,7 +15,8 @@ import numpy as np
 
 from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
-from designopt.transcriptions.base import RawResult, ipopt_options, waypoint_function
+from designopt.transcriptions.base import RawResult, ipopt_options
+from designopt.transcriptions.degeneracy import q_independent_rows
 from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
 
 PRE_ITERATION_STATUSES = {"Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition", "Invalid_Option"}
@@ -55,13 +56,17 @@ class BlockStructure:
     inputs: tuple | None = None
 
 
+# the status of a solve its `DegenerateWatch` stopped (IPOPT itself says User_Requested_Stop)
+STOPPED_DEGENERATE = "Stopped_On_Degenerate_Design"
+
+
 class WaypointNLP:
     """An IPOPT problem whose nonlinear terms are per-waypoint blocks (plus quadratic terms)."""
 
     def __init__(self, problem: DesignProblem, name: str, x, objective, quadratic, constraints: ConstraintList,
                  lbx, ubx, blocks: BlockStructure | list[BlockStructure] | None, max_iter: int, ipopt: dict | None,
-                 t_start: float):
-        self.problem = problem
+                 t_start: float, watch=None):
+        self.problem, self.watch = problem, watch
         g, self.lbg, self.ubg = constraints.stacked()
         self.lbx, self.ubx = np.asarray(lbx, float), np.asarray(ubx, float)
         self.n_variables, self.n_constraints = x.shape[0], g.shape[0]
@@ -75,12 +80,16 @@ class WaypointNLP:
             constant = np.array(ca.evalf(ca.hessian(quadratic, x)[0])) if not isinstance(quadratic, (int, float)) \
                 else np.zeros((x.shape[0], x.shape[0]))
             opts["hess_lag"] = assemble_hessian(self.n_variables, self.n_constraints, groups, constant)
+        if watch is not None:
+            opts["iteration_callback"] = watch
         self.solver = ca.nlpsol(name, "ipopt", {"x": x, "f": objective, "g": g}, opts)
         self.build_time_s = time.perf_counter() - t_start
 
     def run(self, x0: np.ndarray):
         """Solve from x0; returns (x, objective, stats, wall time)."""
         x0 = np.clip(x0, self.lbx, self.ubx)
+        if self.watch is not None:
+            self.watch.reset()
         t0 = time.perf_counter()
         sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         wall = time.perf_counter() - t0
@@ -88,6 +97,8 @@ class WaypointNLP:
 
     def result(self, q_d, Q, V, objective, stats, wall, seed, drift=0.0) -> RawResult:
         status = str(stats.get("return_status", "unknown"))
+        if self.watch is not None and self.watch.stopped:
+            status = STOPPED_DEGENERATE
         # IPOPT stops these before its first iteration, and the reported count is then stale.
         iterations = 0 if status in PRE_ITERATION_STATUSES else int(stats.get("iter_count", -1))
         return RawResult(
@@ -227,15 +238,13 @@ def quadratic_design_costs(problem: DesignProblem, q_d):
 
 
 def once_only_rows(problem: DesignProblem, tracking: str) -> np.ndarray:
-    """Rows of c_k that need holding at the first waypoint only.
+    """Rows of c_k that need holding at one waypoint only: the tracking rows that do not depend on the moving
+    joints (`designopt.transcriptions.degeneracy.q_independent_rows`).
 
-    When no moving joint turns the tool (e.g. a PPP gantry), the tool-axis equalities are the same
-    function of the design joints at every waypoint: 2N equations of rank 2, which breaks IPOPT's
-    constraint qualification (measured: PPP stalled at max_iter). They are then imposed once.
+    When no moving joint turns the tool (a PPP gantry, or a DH arm whose twists are held at 0 or pi), the
+    tool-axis equalities are the same function of the design joints at every waypoint: 2N equations of rank 2,
+    which breaks IPOPT's constraint qualification (measured: PPP stalled at max_iter). They are then imposed once.
     """
     if tracking != "hard":
         return np.zeros(0, dtype=int)
-    chain = problem.chain
-    q, q_d = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design)
-    _, z_W, _, _ = waypoint_function(problem)(q, q_d, ca.SX.zeros(3), ca.SX.zeros(3))
-    return np.array([3, 4, 5]) if not ca.depends_on(z_W, q) else np.zeros(0, dtype=int)
+    return q_independent_rows(problem)

@@ -1,0 +1,145 @@
+"""Designs on which the tracking constraints degenerate, and the problem that holds them (issue 12, cause 3).
+
+When every joint axis of the robot is parallel to the workpiece normal (a DH arm with every twist at 0 or pi,
+a PPP gantry), the tool axis no longer depends on the moving joints, and neither does the tool's height over a
+planar path: the N copies of those tracking rows become copies of one function of the design. The equality
+constraints lose rank there (LICQ fails), and an IPOPT iterate that reaches such a design creeps until its
+iteration cap or fails in restoration (docs/benchmarks.md, "The design-only stall, cause 3").
+
+The set is a piece of the feasible set on its own: with the design angles that put the arm there held, and each
+row that no longer depends on the joints imposed once (`q_independent_rows`), the problem is regular again.
+`held_at_multiples_of_pi` builds that problem from a design; `designopt.multistart` re-solves a start that
+ended there without converging.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import casadi as ca
+import numpy as np
+
+from designopt.kinematics.joints import Role
+from designopt.problem import DesignProblem
+from designopt.transcriptions.base import waypoint_function
+
+POSITION_ROWS, AXIS_ROWS = (0, 1, 2), (3, 4, 5)  # the hard tracking rows: p_W - s_W, then z_W
+
+
+def _sample(lower: np.ndarray, upper: np.ndarray, centre: np.ndarray, kind: np.ndarray, rng) -> np.ndarray:
+    """Uniform within [lower, upper]; an unbounded side is replaced by centre -+ pi (angles) or 1 m (lengths)."""
+    half = np.where(kind == "angle", np.pi, 1.0)
+    lo = np.where(np.isfinite(lower), lower, centre - half)
+    hi = np.where(np.isfinite(upper), upper, centre + half)
+    return rng.uniform(lo, hi)
+
+
+def q_independent_rows(problem: DesignProblem, samples: int = 4, seed: int = 0, tol: float = 1e-9) -> np.ndarray:
+    """The hard tracking rows (0-2 tool position in W, 3-5 tool axis z_W) that do not depend on the moving
+    joints for any design within the design joints' bounds and whose target is the same at every tracked
+    waypoint: holding such a row at one waypoint holds it at all of them.
+
+    Independence is exact when the expression does not contain the joints (a PPP gantry's axis); otherwise it is
+    judged on ``samples`` random (q, q_d) within bounds (a held twist of pi leaves sin(pi) = 1e-16 in the
+    expression): every |d row / dq| below ``tol``."""
+    chain, tp = problem.chain, problem.toolpath
+    q, q_d = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design)
+    p_W, z_W, _, _ = waypoint_function(problem)(q, q_d, ca.SX.zeros(3), ca.SX.zeros(3))
+    rows = ca.vertcat(p_W, z_W)
+    jacobian = ca.Function("drows_dq", [q, q_d], [ca.jacobian(rows, q)])
+    rng = np.random.default_rng(seed)
+    moving, design = chain.moving, chain.design
+    draws = [(_sample(np.array([j.lower for j in moving]), np.array([j.upper for j in moving]),
+                      np.array([j.value for j in moving]), np.array([j.kind for j in moving]), rng),
+              _sample(np.array([j.lower for j in design]), np.array([j.upper for j in design]),
+                      np.array([j.value for j in design]), np.array([j.kind for j in design]), rng))
+             for _ in range(samples)]
+    tracked = tp.is_tracked
+    out = []
+    for i in (*POSITION_ROWS, *AXIS_ROWS):
+        if ca.depends_on(rows[i], q) and any(np.abs(np.asarray(jacobian(a, b))[i]).max() > tol for a, b in draws):
+            continue
+        if i in POSITION_ROWS and np.ptp(tp.points_W[tracked, i]) > 1e-12:
+            continue  # a target that moves: a planar arm cannot follow it, and holding the row once would hide that
+        out.append(i)
+    return np.array(out, dtype=int)
+
+
+def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3) -> tuple[DesignProblem, np.ndarray] | None:
+    """``problem`` with every angle design joint within ``tol`` (rad) of a multiple of pi held there (its bounds
+    set to that value), and the design with those joints snapped; None when no joint not yet held is that close,
+    or when holding them leaves every tracking row depending on the joints (the constraints do not degenerate).
+    A held joint stays a design joint: the solution's layout does not change, IPOPT treats it as fixed."""
+    q_d = np.array(q_d, dtype=float)
+    joints = list(problem.chain.joints)
+    design_index = [i for i, j in enumerate(joints) if j.role is Role.DESIGN]
+    held = 0
+    for k, i in enumerate(design_index):
+        joint = joints[i]
+        snapped = float(np.round(q_d[k] / np.pi) * np.pi)
+        if (joint.kind != "angle" or joint.lower == joint.upper or abs(snapped - q_d[k]) > tol
+                or not joint.lower <= snapped <= joint.upper):
+            continue
+        joints[i] = replace(joint, value=snapped, lower=snapped, upper=snapped)
+        q_d[k] = snapped
+        held += 1
+    if not held:
+        return None
+    candidate = replace(problem, chain=replace(problem.chain, joints=tuple(joints)))
+    if len(q_independent_rows(candidate)) == 0:
+        return None
+    return candidate, q_d
+
+
+class DegenerateWatch(ca.Callback):
+    """IPOPT's per-iteration callback that stops a solve once its design has sat on a degenerate design
+    (`held_at_multiples_of_pi` would hold something) for ``patience`` iterations in a row: from there IPOPT only
+    creeps (cause 3), and `designopt.multistart` finishes the solve with those angles held instead.
+
+    ``x`` is laid out design joints first (q_d = x[:n_d]). ``stopped`` tells whether the last solve was stopped
+    here. A solve that only passes through such a design is not stopped."""
+
+    def __init__(self, problem: DesignProblem, n_x: int, n_g: int, patience: int = 30, tol: float = 1e-3):
+        ca.Callback.__init__(self)
+        self.problem, self.n_x, self.n_g, self.patience, self.tol = problem, n_x, n_g, patience, tol
+        # held joints (lower == upper) are not watched: a problem already held there must be allowed to finish
+        self.angle = np.array([j.kind == "angle" and j.lower < j.upper for j in problem.chain.design], dtype=bool)
+        self._verdicts: dict[tuple[bool, ...], bool] = {}
+        self.run = 0
+        self.stopped = False
+        self.construct("degenerate_watch", {})
+
+    def reset(self) -> None:
+        self.run, self.stopped = 0, False
+
+    def get_n_in(self):
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self):
+        return 1
+
+    def get_name_in(self, i):
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i):
+        return "ret"
+
+    def get_sparsity_in(self, i):
+        name = ca.nlpsol_out(i)
+        n = {"x": self.n_x, "lam_x": self.n_x, "g": self.n_g, "lam_g": self.n_g, "f": 1}.get(name, 0)
+        return ca.Sparsity.dense(n, 1)
+
+    def _degenerate(self, q_d: np.ndarray) -> bool:
+        near = self.angle & (np.abs(q_d - np.round(q_d / np.pi) * np.pi) <= self.tol)
+        if not near.any():
+            return False
+        key = tuple(near)
+        if key not in self._verdicts:
+            self._verdicts[key] = held_at_multiples_of_pi(self.problem, q_d, self.tol) is not None
+        return self._verdicts[key]
+
+    def eval(self, arg):
+        q_d = np.asarray(arg[0]).ravel()[: len(self.angle)]
+        self.run = self.run + 1 if self._degenerate(q_d) else 0
+        self.stopped = self.run >= self.patience
+        return [1 if self.stopped else 0]

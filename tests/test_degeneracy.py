@@ -1,0 +1,111 @@
+"""Degenerate designs (issue 12, cause 3): the tracking rows that stop depending on the joints when every joint
+axis is parallel to the workpiece normal, holding a design there, the watch that stops a creeping solve, and
+the design-only stall this fixes."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from designopt.config import parse_config
+from designopt.evaluation import evaluate
+from designopt.experiments.adapters import multistart_from_config, transcription_for
+from designopt.kinematics.chain import tool_pose
+from designopt.multistart import solve_start
+from designopt.problem import problem_from_config
+from designopt.transcriptions.degeneracy import DegenerateWatch, held_at_multiples_of_pi, q_independent_rows
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def design_only(waypoints: int = 12, max_iter: int = 400, hold: bool = True):
+    raw = yaml.safe_load((ROOT / "configs" / "design_only.yaml").read_text())
+    raw["toolpath"]["waypoints"] = waypoints
+    raw["solver"] = {"max_iter": max_iter, "jobs": 1, "hold_degenerate": hold}
+    cfg = parse_config(raw)
+    return cfg, problem_from_config(cfg)
+
+
+def twists(problem) -> np.ndarray:
+    return np.array([j.name.endswith(".alpha") for j in problem.chain.design])
+
+
+def planar_design(problem, offset: float = 2e-4) -> np.ndarray:
+    """The configured design with every twist within ``offset`` of 0 or -pi (all joint axes parallel)."""
+    q_d = np.array([j.value for j in problem.chain.design])
+    q_d[twists(problem)] = [offset, -np.pi + offset, offset, offset, -np.pi + offset, offset]
+    return q_d
+
+
+def test_a_planar_arm_tracks_its_height_and_axis_without_its_joints():
+    _, problem = design_only()
+    assert len(q_independent_rows(problem)) == 0  # twists free: every row depends on the joints somewhere
+    held, q_d = held_at_multiples_of_pi(problem, planar_design(problem))
+    assert list(q_independent_rows(held)) == [2, 3, 4, 5]  # height p_z and the tool axis, not x and y
+    # closed form: with every twist 0 or pi all z axes are parallel, so the tool axis is +-z and the tool's
+    # height is the signed sum of the d offsets, whatever the joints
+    rng = np.random.default_rng(1)
+    poses = [tool_pose(held.chain, rng.uniform(-np.pi, np.pi, 6), q_d) for _ in range(3)]
+    assert all(np.allclose(abs(T[2, 2]), 1.0) for T in poses)
+    assert np.ptp([T[2, 3] for T in poses]) < 1e-12
+    assert np.ptp([T[0, 3] for T in poses]) > 1e-3  # x still moves: it is tracked at every waypoint
+    # a path whose height changes cannot be followed by a planar arm: its height row is not held once
+    tp = held.toolpath
+    points = tp.points_W.copy()
+    points[:, 2] += np.linspace(0.0, 0.05, tp.n)
+    climbing = replace(held, toolpath=replace(tp, points_W=points))
+    assert list(q_independent_rows(climbing)) == [3, 4, 5]
+
+
+def test_holding_snaps_the_angles_near_a_multiple_of_pi_and_nothing_else():
+    _, problem = design_only()
+    q_d = planar_design(problem)
+    held, snapped = held_at_multiples_of_pi(problem, q_d)
+    mask = twists(problem)
+    assert np.array_equal(snapped[mask], [0.0, -np.pi, 0.0, 0.0, -np.pi, 0.0])
+    assert np.array_equal(snapped[~mask], q_d[~mask])  # lengths are not touched
+    for joint, value, twist in zip(held.chain.design, snapped, mask, strict=True):
+        assert (joint.lower == joint.upper == value) if twist else joint.lower < joint.upper
+    assert held_at_multiples_of_pi(held, snapped) is None  # held joints are not held again
+    assert held_at_multiples_of_pi(problem, q_d + 0.01 * mask) is None  # 1e-2 rad off: not degenerate
+    # the PUMA-560 has twists of 0 (links 2 and 6), but its other axes are perpendicular: nothing degenerates
+    assert held_at_multiples_of_pi(problem, np.array([j.value for j in problem.chain.design])) is None
+
+
+def test_the_watch_stops_only_a_solve_that_stays_on_a_degenerate_design():
+    _, problem = design_only()
+    n_d = problem.chain.n_design
+    watch = DegenerateWatch(problem, n_x=n_d + 5, n_g=3, patience=3)
+
+    def step(q_d):
+        return watch.eval([np.concatenate([q_d, np.zeros(5)]), 0.0, np.zeros(3), np.zeros(n_d + 5), np.zeros(3),
+                           np.zeros(0)])[0]
+
+    planar, puma = planar_design(problem), np.array([j.value for j in problem.chain.design])
+    assert [step(planar), step(planar), step(puma), step(planar), step(planar)] == [0, 0, 0, 0, 0]
+    assert step(planar) == 1 and watch.stopped  # the third in a row
+    watch.reset()
+    assert not watch.stopped and step(planar) == 0
+
+
+@pytest.mark.parametrize("hold", [False, True])
+def test_a_solve_stalled_on_a_planar_design_is_finished_with_its_twists_held(hold):
+    # start 3 of the design-only problem on 12 waypoints walks into a planar arm (twists 0 and -pi) and, as is,
+    # creeps there until the iteration cap (measured: 400 iterations, cost 0.42)
+    cfg, problem = design_only(hold=hold)
+    sol = solve_start(problem, transcription_for(cfg), multistart_from_config(cfg), 3)
+    if not hold:
+        assert sol.raw.status == "Maximum_Iterations_Exceeded"
+        assert held_at_multiples_of_pi(problem, sol.raw.q_d) is not None  # it stalled on a degenerate design
+        return
+    assert sol.raw.success, sol.raw.status
+    assert sol.raw.held.split() == [j.name for j in problem.chain.design if j.name.endswith(".alpha")]
+    assert sol.raw.iterations < 400 and sol.metrics.tracks
+    assert sol.metrics.design_cost < 0.5 * 0.4238
+    again = evaluate(problem, sol.raw.q_d, sol.raw.Q, sol.raw.V)  # a solution of the problem as posed
+    assert again.tracks and np.isclose(again.design_cost, sol.metrics.design_cost, rtol=1e-12)
+    assert all(j.lower <= v <= j.upper for j, v in zip(problem.chain.design, sol.raw.q_d, strict=True))
