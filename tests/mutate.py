@@ -101,8 +101,8 @@ MUTATIONS = [
              "settings, search, search.screen_max_iter)", "settings, search)"),
     # degenerate designs (issue 12, cause 3)
     Mutation("a moving target's row held once", "designopt/transcriptions/degeneracy.py",
-             "if i in POSITION_ROWS and np.ptp(tp.points_W[tracked, i]) > 1e-12:",
-             "if i in POSITION_ROWS and np.ptp(tp.points_W[tracked, i]) > 1e12:"),
+             "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e-12:",
+             "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e12:"),
     Mutation("a stalled solve is continued without holding its angles", "designopt/multistart.py",
              "more = _solve_built(held_problem, warm,", "more = _solve_built(problem, warm,"),
 ]

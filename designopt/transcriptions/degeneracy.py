@@ -59,7 +59,7 @@ def q_independent_rows(problem: DesignProblem, samples: int = 4, seed: int = 0, 
     for i in (*POSITION_ROWS, *AXIS_ROWS):
         if ca.depends_on(rows[i], q) and any(np.abs(np.asarray(jacobian(a, b))[i]).max() > tol for a, b in draws):
             continue
-        if i in POSITION_ROWS and np.ptp(tp.points_W[tracked, i]) > 1e-12:
+        if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e-12:
             continue  # a target that moves: a planar arm cannot follow it, and holding the row once would hide that
         out.append(i)
     return np.array(out, dtype=int)
