@@ -103,6 +103,9 @@ MUTATIONS = [
     Mutation("a moving target's row held once", "designopt/transcriptions/degeneracy.py",
              "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e-12:",
              "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e12:"),
+    Mutation("a gantry's own once-only rows count as degenerate", "designopt/transcriptions/degeneracy.py",
+             "if len(q_independent_rows(candidate)) <= len(q_independent_rows(problem)):",
+             "if len(q_independent_rows(candidate)) == 0:"),
     Mutation("a stalled solve is continued without holding its angles", "designopt/multistart.py",
              "more = _solve_built(held_problem, warm,", "more = _solve_built(problem, warm,"),
 ]

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from conftest import gantry_config
 
 from designopt.config import parse_config
 from designopt.evaluation import evaluate
@@ -74,6 +75,15 @@ def test_holding_snaps_the_angles_near_a_multiple_of_pi_and_nothing_else():
     assert held_at_multiples_of_pi(problem, q_d + 0.01 * mask) is None  # 1e-2 rad off: not degenerate
     # the PUMA-560 has twists of 0 (links 2 and 6), but its other axes are perpendicular: nothing degenerates
     assert held_at_multiples_of_pi(problem, np.array([j.value for j in problem.chain.design])) is None
+    # a PPP gantry's axis rows never depended on its joints (they are held once already): holding the angles of
+    # its configured design that are multiples of pi frees no further row (its three axes stay orthogonal)
+    gantry = problem_from_config(parse_config(gantry_config(robot={"design": ["theta", "a", "alpha"]},
+                                                            placement={"optimize": True})))
+    assert list(q_independent_rows(gantry)) == [3, 4, 5]
+    configured = np.array([j.value for j in gantry.chain.design])
+    at_pi = np.array([j.kind == "angle" and abs(np.sin(j.value)) < 1e-12 for j in gantry.chain.design])
+    assert at_pi.sum() >= 4
+    assert held_at_multiples_of_pi(gantry, configured + 1e-4 * at_pi) is None
 
 
 def test_the_watch_stops_only_a_solve_that_stays_on_a_degenerate_design():

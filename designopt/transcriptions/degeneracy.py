@@ -68,7 +68,7 @@ def q_independent_rows(problem: DesignProblem, samples: int = 4, seed: int = 0, 
 def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3) -> tuple[DesignProblem, np.ndarray] | None:
     """``problem`` with every angle design joint within ``tol`` (rad) of a multiple of pi held there (its bounds
     set to that value), and the design with those joints snapped; None when no joint not yet held is that close,
-    or when holding them leaves every tracking row depending on the joints (the constraints do not degenerate).
+    or when holding them frees no tracking row from the joints that the problem did not already hold once.
     A held joint stays a design joint: the solution's layout does not change, IPOPT treats it as fixed."""
     q_d = np.array(q_d, dtype=float)
     joints = list(problem.chain.joints)
@@ -86,8 +86,8 @@ def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3) -> t
     if not held:
         return None
     candidate = replace(problem, chain=replace(problem.chain, joints=tuple(joints)))
-    if len(q_independent_rows(candidate)) == 0:
-        return None
+    if len(q_independent_rows(candidate)) <= len(q_independent_rows(problem)):
+        return None  # e.g. a PPP gantry, whose axis rows never depended on its joints: nothing degenerates here
     return candidate, q_d
 
 
