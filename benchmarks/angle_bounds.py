@@ -8,16 +8,13 @@ to [-A, A], print status, iterations, seconds, design cost and tracking per star
 from __future__ import annotations
 
 import argparse
-import time
+import sys
 from pathlib import Path
 
 import yaml
-from joblib import Parallel, delayed
 
-from designopt.config import parse_config
-from designopt.experiments.adapters import multistart_from_config, transcription_for
-from designopt.multistart import solve_start
-from designopt.problem import problem_from_config
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from cold_starts import solve_cold_starts  # noqa: E402
 
 
 def main() -> None:
@@ -30,18 +27,8 @@ def main() -> None:
     raw = yaml.safe_load(args.config.read_text())
     raw["robot"]["bounds"] = {**raw["robot"].get("bounds", {}), "angle": [-args.angle, args.angle]}
     raw["solver"]["max_iter"] = args.max_iter
-    cfg = parse_config(raw, args.config, args.config.parent)
-    problem = problem_from_config(cfg, args.config.parent)
-    transcription = transcription_for(cfg)
-
-    def run(i):
-        t0 = time.perf_counter()
-        sol = solve_start(problem, transcription, multistart_from_config(cfg), i)
-        return (i, sol.raw.status, sol.raw.iterations, round(time.perf_counter() - t0, 1),
-                f"{sol.metrics.design_cost:.4g}", sol.metrics.tracks)
-
-    for row in Parallel(n_jobs=2)(delayed(run)(i) for i in range(args.starts)):
-        print(args.angle, row, flush=True)
+    for i, status, its, sec, cost, tracks, _ in solve_cold_starts(raw, args.config, range(args.starts)):
+        print(args.angle, (i, status, its, round(sec, 1), f"{cost:.4g}", tracks), flush=True)
 
 
 if __name__ == "__main__":

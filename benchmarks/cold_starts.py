@@ -23,6 +23,22 @@ from designopt.multistart import solve_start
 from designopt.problem import problem_from_config
 
 
+def solve_cold_starts(raw: dict, config: Path, starts: range, jobs: int = 2) -> list[tuple]:
+    """Solve the given seeded starts of the config ``raw`` (read from ``config``) in parallel; one row per start:
+    (index, status, iterations, seconds, design cost, tracks, held joints)."""
+    cfg = parse_config(raw, config, config.parent)
+    problem = problem_from_config(cfg, config.parent)
+    transcription = transcription_for(cfg)
+
+    def run(i):
+        t0 = time.perf_counter()
+        sol = solve_start(problem, transcription, multistart_from_config(cfg), i)
+        return (i, sol.raw.status, sol.raw.iterations, time.perf_counter() - t0, sol.metrics.design_cost,
+                sol.metrics.tracks, sol.raw.held)
+
+    return Parallel(n_jobs=jobs)(delayed(run)(i) for i in starts)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("config", type=Path)
@@ -36,17 +52,7 @@ def main() -> None:
     raw.setdefault("solver", {})["hold_degenerate"] = not args.no_hold
     if args.max_iter is not None:
         raw["solver"]["max_iter"] = args.max_iter
-    cfg = parse_config(raw, args.config, args.config.parent)
-    problem = problem_from_config(cfg, args.config.parent)
-    transcription = transcription_for(cfg)
-
-    def run(i):
-        t0 = time.perf_counter()
-        sol = solve_start(problem, transcription, multistart_from_config(cfg), i)
-        return (i, sol.raw.status, sol.raw.iterations, time.perf_counter() - t0, sol.metrics.design_cost,
-                sol.metrics.tracks, sol.raw.held)
-
-    rows = Parallel(n_jobs=args.jobs)(delayed(run)(i) for i in range(args.first, args.first + args.starts))
+    rows = solve_cold_starts(raw, args.config, range(args.first, args.first + args.starts), args.jobs)
     for i, status, its, sec, cost, tracks, held in rows:
         print(f"start {i}: {status} {its} it {sec:.1f} s cost {cost:.5g} tracks={tracks}"
               + (f" held [{held}]" if held else ""), flush=True)
