@@ -119,3 +119,10 @@ def test_a_solve_stalled_on_a_planar_design_is_finished_with_its_twists_held(hol
     again = evaluate(problem, sol.raw.q_d, sol.raw.Q, sol.raw.V)  # a solution of the problem as posed
     assert again.tracks and np.isclose(again.design_cost, sol.metrics.design_cost, rtol=1e-12)
     assert all(j.lower <= v <= j.upper for j, v in zip(problem.chain.design, sol.raw.q_d, strict=True))
+
+
+def test_check_says_whether_stalled_solves_are_held():
+    from designopt.experiments.adapters import describe_search
+
+    assert "finished held" in describe_search(design_only(hold=True)[0])
+    assert "held" not in describe_search(design_only(hold=False)[0])

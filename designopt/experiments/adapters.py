@@ -40,13 +40,14 @@ def search_from_config(cfg: Config) -> Search:
 def describe_search(cfg: Config) -> str:
     """The config's search in words."""
     s = cfg.solver.search
+    held = "; a solve stalled on a degenerate design is finished held" if cfg.solver.hold_degenerate else ""
     if s.strategy == "multistart":
-        return f"multistart, {cfg.solver.multistart} starts"
+        return f"multistart, {cfg.solver.multistart} starts{held}"
     screen = (f", the best {s.screen} distinct re-ranked on {s.screen_waypoints} waypoints (<= {s.screen_max_iter} "
               f"iterations, if the path has more)"
               if s.screen_waypoints else "")
     return (f"coarse to fine: {s.explore_starts} starts on {s.explore_waypoints} waypoints (<= {s.explore_max_iter} "
-            f"iterations){screen}, the best {s.refine} distinct optima refined on the full path")
+            f"iterations){screen}, the best {s.refine} distinct optima refined on the full path{held}")
 
 
 def case_config(cfg: Config, case: str) -> Config:
