@@ -26,11 +26,13 @@ from designopt.transcriptions.base import waypoint_function
 POSITION_ROWS, AXIS_ROWS = (0, 1, 2), (3, 4, 5)  # the hard tracking rows: p_W - s_W, then z_W
 
 
-def _sample(lower: np.ndarray, upper: np.ndarray, centre: np.ndarray, kind: np.ndarray, rng) -> np.ndarray:
-    """Uniform within [lower, upper]; an unbounded side is replaced by centre -+ pi (angles) or 1 m (lengths)."""
-    half = np.where(kind == "angle", np.pi, 1.0)
-    lo = np.where(np.isfinite(lower), lower, centre - half)
-    hi = np.where(np.isfinite(upper), upper, centre + half)
+def _sample(joints, rng) -> np.ndarray:
+    """Uniform within each joint's bounds; an unbounded side is replaced by value -+ pi (angles) or 1 m (lengths)."""
+    value = np.array([j.value for j in joints])
+    half = np.where(np.array([j.kind for j in joints]) == "angle", np.pi, 1.0)
+    lower, upper = np.array([j.lower for j in joints]), np.array([j.upper for j in joints])
+    lo = np.where(np.isfinite(lower), lower, value - half)
+    hi = np.where(np.isfinite(upper), upper, value + half)
     return rng.uniform(lo, hi)
 
 
@@ -48,12 +50,7 @@ def q_independent_rows(problem: DesignProblem, samples: int = 4, seed: int = 0, 
     rows = ca.vertcat(p_W, z_W)
     jacobian = ca.Function("drows_dq", [q, q_d], [ca.jacobian(rows, q)])
     rng = np.random.default_rng(seed)
-    moving, design = chain.moving, chain.design
-    draws = [(_sample(np.array([j.lower for j in moving]), np.array([j.upper for j in moving]),
-                      np.array([j.value for j in moving]), np.array([j.kind for j in moving]), rng),
-              _sample(np.array([j.lower for j in design]), np.array([j.upper for j in design]),
-                      np.array([j.value for j in design]), np.array([j.kind for j in design]), rng))
-             for _ in range(samples)]
+    draws = [(_sample(chain.moving, rng), _sample(chain.design, rng)) for _ in range(samples)]
     tracked = tp.is_tracked
     out = []
     for i in (*POSITION_ROWS, *AXIS_ROWS):
