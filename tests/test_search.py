@@ -12,15 +12,23 @@ import pytest
 import yaml
 
 from designopt.config import parse_config
-from designopt.experiments.adapters import multistart_from_config, transcription_for
+from designopt.experiments.adapters import multistart_from_config, search_from_config, transcription_for
 from designopt.experiments.run import run_experiment
 from designopt.multistart import solve_start
 from designopt.problem import problem_from_config
-from designopt.search import coarse_problem, distinct_best, lifted_guess
+from designopt.search import Search, coarse_problem, distinct_best, lifted_guess
 from designopt.solution import solve_and_evaluate
 from designopt.toolpaths import figure_eight, subsample
 
 ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_the_config_and_the_library_share_the_search_defaults():
+    # The defaults are written twice (pydantic validates the config, the library runs without one): a user who
+    # leaves `solver.search` out must get what `Search()` documents.
+    assert search_from_config(parse_config({})) == Search()
+    changed = search_from_config(parse_config({"solver": {"search": {"screen": 5, "strategy": "multistart"}}}))
+    assert (changed.screen, changed.strategy) == (5, "multistart")
 
 
 def test_a_coarse_path_is_a_subset_of_the_task():

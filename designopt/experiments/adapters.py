@@ -31,10 +31,8 @@ def multistart_from_config(cfg: Config) -> Multistart:
 
 
 def search_from_config(cfg: Config) -> Search:
-    s = cfg.solver.search
-    return Search(strategy=s.strategy, explore_waypoints=s.explore_waypoints, explore_starts=s.explore_starts,
-                  explore_max_iter=s.explore_max_iter, refine=s.refine, distinct=s.distinct,
-                  screen_waypoints=s.screen_waypoints, screen=s.screen, screen_max_iter=s.screen_max_iter)
+    """The library's `Search` from ``solver.search`` (every key but the sweep's ``structure_neighbours``)."""
+    return Search(**cfg.solver.search.model_dump(exclude={"structure_neighbours"}))
 
 
 def describe_search(cfg: Config) -> str:
