@@ -1,0 +1,65 @@
+"""How close a start's design comes to losing a task direction (issue 12, design-only cause 4).
+
+Solves the given seeded cold starts of a config one at a time and prints, at the point each solve stops, the
+smallest singular value of the tracking Jacobian d(p_W, z_x, z_y)/dq (5 rows: tool position and the two tool
+axis components the task constrains, against the moving joints) over the path's waypoints, and the full
+spectrum and Jacobian at the middle waypoint. A singular value near 0 at *every* waypoint means the design has
+made the tracking rows dependent (the constraints' linear independence fails along the whole path).
+
+    .venv/bin/python benchmarks/tracking_rank.py configs/design_only.yaml 1 11 0
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import yaml
+
+from designopt.config import parse_config
+from designopt.experiments.adapters import multistart_from_config, transcription_for
+from designopt.multistart import solve_start
+from designopt.problem import problem_from_config
+from designopt.transcriptions.base import waypoint_function
+
+
+def tracking_jacobian(problem) -> ca.Function:
+    """(q, q_d, s_W) -> the 5 x n_moving Jacobian of (p_W, z_x, z_y) with respect to q."""
+    f = waypoint_function(problem)
+    q = ca.SX.sym("q", problem.chain.n_moving)
+    q_d = ca.SX.sym("q_d", problem.chain.n_design)
+    s_W = ca.SX.sym("s_W", 3)
+    p_W, z_W, _, _ = f(q, q_d, s_W, ca.DM.zeros(3))
+    return ca.Function("J_track", [q, q_d, s_W], [ca.jacobian(ca.vertcat(p_W, z_W[:2]), q)])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("config", type=Path)
+    parser.add_argument("starts", type=int, nargs="+")
+    args = parser.parse_args()
+    cfg = parse_config(yaml.safe_load(args.config.read_text()), args.config, args.config.parent)
+    problem = problem_from_config(cfg, args.config.parent)
+    transcription = transcription_for(cfg)
+    jac = tracking_jacobian(problem)
+    points = np.asarray(problem.toolpath.points_W)
+    np.set_printoptions(precision=3, suppress=True, linewidth=150)
+    for i in args.starts:
+        sol = solve_start(problem, transcription, multistart_from_config(cfg), i)
+        Q = np.asarray(sol.raw.Q)
+        sigma = np.array([np.linalg.svd(np.asarray(jac(Q[k], sol.raw.q_d, points[k])), compute_uv=False)[-1]
+                          for k in range(len(Q))])
+        print(f"start {i}: {sol.raw.status}, {sol.raw.iterations} iterations, cost {sol.metrics.design_cost:.4g}; "
+              f"smallest singular value over the path: min {sigma.min():.3g}, median {np.median(sigma):.3g}")
+        k = len(Q) // 2
+        J = np.asarray(jac(Q[k], sol.raw.q_d, points[k]))
+        print(f"  middle waypoint: singular values {np.linalg.svd(J, compute_uv=False)}")
+        print("  " + str(J).replace("\n", "\n  "))
+        print("  design: " + ", ".join(f"{j.name} {v:.4g}" for j, v in zip(problem.chain.design, sol.raw.q_d,
+                                                                            strict=True)))
+
+
+if __name__ == "__main__":
+    main()
