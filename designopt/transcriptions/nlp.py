@@ -70,6 +70,7 @@ class WaypointNLP:
         g, self.lbg, self.ubg = constraints.stacked()
         self.lbx, self.ubx = np.asarray(lbx, float), np.asarray(ubx, float)
         self.n_variables, self.n_constraints = x.shape[0], g.shape[0]
+        self.n_equalities = int(np.sum(self.lbg == self.ubg))
         opts = ipopt_options(max_iter, ipopt)
         if blocks is not None:
             groups = []
@@ -88,6 +89,10 @@ class WaypointNLP:
     def run(self, x0: np.ndarray):
         """Solve from x0; returns (x, objective, stats, wall time)."""
         x0 = np.clip(x0, self.lbx, self.ubx)
+        if self.n_equalities > self.n_variables:
+            # IPOPT would stop here before its first iteration, but only after CasADi printed a warning on the
+            # terminal, once per solve (a sweep's one-joint structures: hundreds of lines).
+            return x0, float("nan"), {"return_status": "Not_Enough_Degrees_Of_Freedom", "success": False}, 0.0
         if self.watch is not None:
             self.watch.reset()
         t0 = time.perf_counter()
