@@ -89,12 +89,12 @@ class WaypointNLP:
     def run(self, x0: np.ndarray):
         """Solve from x0; returns (x, objective, stats, wall time)."""
         x0 = np.clip(x0, self.lbx, self.ubx)
+        if self.watch is not None:
+            self.watch.reset()
         if self.n_equalities > self.n_variables:
             # IPOPT would stop here before its first iteration, but only after CasADi printed a warning on the
             # terminal, once per solve (a sweep's one-joint structures: hundreds of lines).
             return x0, float("nan"), {"return_status": "Not_Enough_Degrees_Of_Freedom", "success": False}, 0.0
-        if self.watch is not None:
-            self.watch.reset()
         t0 = time.perf_counter()
         sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         wall = time.perf_counter() - t0
