@@ -14,7 +14,6 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import casadi as ca
 import numpy as np
 import yaml
 
@@ -22,17 +21,7 @@ from designopt.config import parse_config
 from designopt.experiments.adapters import multistart_from_config, transcription_for
 from designopt.multistart import solve_start
 from designopt.problem import problem_from_config
-from designopt.transcriptions.base import waypoint_function
-
-
-def tracking_jacobian(problem) -> ca.Function:
-    """(q, q_d, s_W) -> the 5 x n_moving Jacobian of (p_W, z_x, z_y) with respect to q."""
-    f = waypoint_function(problem)
-    q = ca.SX.sym("q", problem.chain.n_moving)
-    q_d = ca.SX.sym("q_d", problem.chain.n_design)
-    s_W = ca.SX.sym("s_W", 3)
-    p_W, z_W, _, _ = f(q, q_d, s_W, ca.DM.zeros(3))
-    return ca.Function("J_track", [q, q_d, s_W], [ca.jacobian(ca.vertcat(p_W, z_W[:2]), q)])
+from designopt.transcriptions.degeneracy import tracking_jacobian
 
 
 def main() -> None:
@@ -43,18 +32,21 @@ def main() -> None:
     cfg = parse_config(yaml.safe_load(args.config.read_text()), args.config, args.config.parent)
     problem = problem_from_config(cfg, args.config.parent)
     transcription = transcription_for(cfg)
-    jac = tracking_jacobian(problem)
-    points = np.asarray(problem.toolpath.points_W)
+    full = tracking_jacobian(problem)
+
+    def jac(q, q_d):  # the 5 rows the task constrains: position and the axis's x, y
+        return np.asarray(full(q, q_d))[:5]
+
     np.set_printoptions(precision=3, suppress=True, linewidth=150)
     for i in args.starts:
         sol = solve_start(problem, transcription, multistart_from_config(cfg), i)
         Q = np.asarray(sol.raw.Q)
-        sigma = np.array([np.linalg.svd(np.asarray(jac(Q[k], sol.raw.q_d, points[k])), compute_uv=False)[-1]
+        sigma = np.array([np.linalg.svd(jac(Q[k], sol.raw.q_d), compute_uv=False)[-1]
                           for k in range(len(Q))])
         print(f"start {i}: {sol.raw.status}, {sol.raw.iterations} iterations, cost {sol.metrics.design_cost:.4g}; "
               f"smallest singular value over the path: min {sigma.min():.3g}, median {np.median(sigma):.3g}")
         k = len(Q) // 2
-        J = np.asarray(jac(Q[k], sol.raw.q_d, points[k]))
+        J = jac(Q[k], sol.raw.q_d)
         print(f"  middle waypoint: singular values {np.linalg.svd(J, compute_uv=False)}")
         print("  " + str(J).replace("\n", "\n  "))
         print("  design: " + ", ".join(f"{j.name} {v:.4g}" for j, v in zip(problem.chain.design, sol.raw.q_d,
