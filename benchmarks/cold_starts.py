@@ -1,4 +1,4 @@
-"""Cold full-path starts of a config, one per seeded start, with the stalled-design hold on or off (issue 12).
+"""Cold full-path starts of a config, one per seeded start, with the stalled-design hold on or off.
 
 Prints one line per start (status, iterations, seconds, design cost, tracking, held joints) and a summary:
 median (min-max) seconds and iterations, starts at the iteration cap, best and median design cost.
@@ -11,28 +11,30 @@ from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-import yaml
 from joblib import Parallel, delayed
 
-from designopt.config import parse_config
-from designopt.experiments.adapters import multistart_from_config, transcription_for
-from designopt.multistart import solve_start
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
 from designopt.problem import problem_from_config
+from designopt.solve import Seeded, solve_one
 
 
-def solve_cold_starts(raw: dict, config: Path, starts: range, jobs: int = 2) -> list[tuple]:
-    """Solve the given seeded starts of the config ``raw`` (read from ``config``) in parallel; one row per start:
-    (index, status, iterations, seconds, design cost, tracks, held joints)."""
-    cfg = parse_config(raw, config, config.parent)
-    problem = problem_from_config(cfg, config.parent)
-    transcription = transcription_for(cfg)
+def solve_cold_starts(config: Path, starts: range, jobs: int = 2, hold: bool = True,
+                      max_iter: int | None = None) -> list[tuple]:
+    """Solve the given seeded starts of a config in parallel (its search's seed, perturbation and profile); one row
+    per start: (index, status, iterations, seconds, design cost, tracks, held joints)."""
+    cfg = load_config(config)
+    problem, search = problem_from_config(cfg), search_from_config(cfg)
+    profile = search.profile if max_iter is None else replace(search.profile, max_iter=max_iter)
 
     def run(i):
         t0 = time.perf_counter()
-        sol = solve_start(problem, transcription, multistart_from_config(cfg), i)
+        sol = solve_one(problem, Seeded(search.seed, i, search.perturbation, search.init), profile=profile,
+                        hold_degenerate=hold)
         return (i, sol.raw.status, sol.raw.iterations, time.perf_counter() - t0, sol.metrics.design_cost,
                 sol.metrics.tracks, sol.raw.held)
 
@@ -44,15 +46,12 @@ def main() -> None:
     parser.add_argument("config", type=Path)
     parser.add_argument("--starts", type=int, default=8)
     parser.add_argument("--first", type=int, default=0, help="first start index")
-    parser.add_argument("--max-iter", type=int, default=None, help="default: the config's solver.max_iter")
-    parser.add_argument("--no-hold", action="store_true", help="solver.hold_degenerate: false")
+    parser.add_argument("--max-iter", type=int, default=None, help="default: the config's search profile's")
+    parser.add_argument("--no-hold", action="store_true", help="do not finish stalled solves held")
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
-    raw = yaml.safe_load(args.config.read_text())
-    raw.setdefault("solver", {})["hold_degenerate"] = not args.no_hold
-    if args.max_iter is not None:
-        raw["solver"]["max_iter"] = args.max_iter
-    rows = solve_cold_starts(raw, args.config, range(args.first, args.first + args.starts), args.jobs)
+    rows = solve_cold_starts(args.config, range(args.first, args.first + args.starts), args.jobs, not args.no_hold,
+                             args.max_iter)
     for i, status, its, sec, cost, tracks, held in rows:
         print(f"start {i}: {status} {its} it {sec:.1f} s cost {cost:.5g} tracks={tracks}"
               + (f" held [{held}]" if held else ""), flush=True)

@@ -1,10 +1,10 @@
-"""Does the answer depend on the seed? `designopt run CONFIG --no-figures` for several search seeds (issue 11).
+"""Does the answer depend on the seed? `designopt run CONFIG --no-figures` for several search seeds.
 
 Each seed is one run of the CLI in a subprocess (wall time includes start-up, the NLP builds and the search);
 its best design cost is compared with the best design known for the problem (a solution file).
 
     .venv/bin/python benchmarks/search_seeds.py [--config configs/milling.yaml] [--seeds 5]
-        [--reference benchmarks/reference/milling_best_known.json] [--set solver.search.strategy=multistart]
+        [--reference benchmarks/reference/milling_best_known.json] [--set search.preset=paper]
 
 Prints one line per seed, then the spread between seeds and the worst ratio to the best known.
 """
@@ -39,7 +39,7 @@ def main() -> None:
     parser.add_argument("--first-seed", type=int, default=0)
     parser.add_argument("--out", help="keep the runs here (default: a temporary directory)")
     parser.add_argument("--set", action="append", default=[], help="KEY=VALUE (YAML value), e.g. "
-                                                                     "solver.search.explore_starts=120")
+                                                                     "search.starts=120")
     args = parser.parse_args()
     config = ROOT / args.config
     base = yaml.safe_load(config.read_text())
@@ -52,7 +52,7 @@ def main() -> None:
         tmp = args.out or scratch
         for seed in range(args.first_seed, args.first_seed + args.seeds):
             cfg = json.loads(json.dumps(base))
-            _set(cfg, "solver.seed", seed)
+            _set(cfg, "search.seed", seed)
             path = config.parent / f".bench-seed{seed}.yaml"  # beside the original: relative files resolve
             path.write_text(yaml.safe_dump(cfg))
             try:

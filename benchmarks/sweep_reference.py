@@ -1,8 +1,8 @@
-"""Is the sweep's best per structure close to what a large budget finds? (issue 11, sweep target)
+"""Is the sweep's best per structure close to what a large budget finds?
 
-For each named structure, `designopt run` on the sweep's config with that structure and a large search budget
-(default: 240 coarse starts, the best 8 distinct optima refined, another seed than the sweep's), then the ratio
-of the sweep's best (its table.csv) to that reference. A ratio below 1 means the sweep found the better design.
+For each named structure, a run of the sweep's config with that structure and a large search budget (default:
+240 coarse starts, the best 8 distinct optima refined, another seed than the sweep's), then the ratio of the
+sweep's best (its table.csv) to that reference. A ratio below 1 means the sweep found the better design.
 
     .venv/bin/python benchmarks/sweep_reference.py results/structures/<run> RRR RPR RRRR ... [--starts 240]
 """
@@ -10,17 +10,17 @@ of the sweep's best (its table.csv) to that reference. A ratio below 1 means the
 from __future__ import annotations
 
 import argparse
-import json
-import subprocess
-import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
 import yaml
 
-ROOT = Path(__file__).resolve().parent.parent
+from designopt.config import parse_config
+from designopt.experiments.adapters import search_from_config, structure_config
+from designopt.experiments.run import run_experiment
 
 
 def main() -> None:
@@ -33,21 +33,15 @@ def main() -> None:
     args = parser.parse_args()
     sweep = Path(args.sweep)
     table = pd.read_csv(sweep / "table.csv").set_index("structure")
-    base = yaml.safe_load((sweep / "config.yaml").read_text())
+    base = parse_config(yaml.safe_load((sweep / "config.yaml").read_text()), sweep / "config.yaml", sweep)
+    search = replace(search_from_config(base), starts=args.starts, refine=args.refine, seed=args.seed)
     ratios = []
     with tempfile.TemporaryDirectory() as tmp:
         for structure in args.structures:
-            cfg = json.loads(json.dumps(base))
-            cfg["robot"].update(structure=structure, dh="generic", design=["d", "a", "alpha"])
-            cfg["solver"]["seed"] = args.seed
-            cfg["solver"]["search"] = {**cfg["solver"].get("search", {}), "explore_starts": args.starts,
-                                       "refine": args.refine}
-            path = Path(tmp) / f"{structure}.yaml"
-            path.write_text(yaml.safe_dump(cfg))
             t0 = time.perf_counter()
-            subprocess.run([sys.executable, "-m", "cli.main", "run", str(path), "--out", tmp, "--name", structure,
-                            "--no-figures"], cwd=ROOT, check=True, capture_output=True)
-            best = json.loads((Path(tmp) / cfg["name"] / structure / "best.json").read_text())["metrics"]["design_cost"]
+            result = run_experiment(structure_config(base, structure), Path(tmp), structure, figures=False,
+                                    search=search)
+            best = result.best.metrics.design_cost
             swept = float(table.loc[structure, "design_cost"])
             ratios.append(swept / best)
             print(f"{structure:7s} sweep {swept:.6g}  large budget {best:.6g}  ratio {swept / best:.3f}  "

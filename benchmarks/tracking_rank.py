@@ -1,4 +1,4 @@
-"""How close a start's design comes to losing a task direction (issue 12, design-only cause 4).
+"""How close a start's design comes to losing a task direction (design-only cause 4, docs/decisions.md).
 
 Solves the given seeded cold starts of a config one at a time and prints, at the point each solve stops, the
 smallest singular value of the tracking Jacobian d(p_W, z_x, z_y)/dq (5 rows: tool position and the two tool
@@ -15,12 +15,11 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-import yaml
 
-from designopt.config import parse_config
-from designopt.experiments.adapters import multistart_from_config, transcription_for
-from designopt.multistart import solve_start
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
 from designopt.problem import problem_from_config
+from designopt.solve import Seeded, solve_one
 from designopt.transcriptions.degeneracy import tracking_jacobian
 
 
@@ -29,9 +28,8 @@ def main() -> None:
     parser.add_argument("config", type=Path)
     parser.add_argument("starts", type=int, nargs="+")
     args = parser.parse_args()
-    cfg = parse_config(yaml.safe_load(args.config.read_text()), args.config, args.config.parent)
-    problem = problem_from_config(cfg, args.config.parent)
-    transcription = transcription_for(cfg)
+    cfg = load_config(args.config)
+    problem, search = problem_from_config(cfg), search_from_config(cfg)
     full = tracking_jacobian(problem)
 
     def jac(q, q_d):  # the 5 rows the task constrains: position and the axis's x, y
@@ -39,7 +37,7 @@ def main() -> None:
 
     np.set_printoptions(precision=3, suppress=True, linewidth=150)
     for i in args.starts:
-        sol = solve_start(problem, transcription, multistart_from_config(cfg), i)
+        sol = solve_one(problem, Seeded(search.seed, i, search.perturbation, search.init), profile=search.profile)
         Q = np.asarray(sol.raw.Q)
         sigma = np.array([np.linalg.svd(jac(Q[k], sol.raw.q_d), compute_uv=False)[-1]
                           for k in range(len(Q))])

@@ -90,15 +90,18 @@ def run(
     name: Annotated[str | None, typer.Option("--name", help="Run name (default: a timestamp).")] = None,
     no_figures: Annotated[bool, typer.Option("--no-figures", help="Skip the figures.")] = False,
     urdf: Annotated[bool, typer.Option("--urdf", help="Also export the best design as URDF (see export).")] = False,
-    resume: Annotated[bool, typer.Option("--resume", help="Finish the run --name: keep its finished starts, "
+    resume: Annotated[bool, typer.Option("--resume", help="Finish the run --name: keep its finished solves, "
                                                           "solve the rest.")] = False,
+    jobs: Annotated[int, typer.Option("--jobs", help="Worker processes (-1: every core).")] = -1,
 ):
-    """Solve one design problem (TO, searched: README "Search") and write results/<experiment>/<run>/."""
+    """Search one design problem (config's search: README "Search") and write results/<experiment>/<run>/.
+
+    Exit code 0 when a design tracks the path, 3 when none does, 2 for bad input."""
     from designopt.experiments.run import run_experiment
 
     cfg = load(config)
     with Bar(f"{cfg.name}: solving") as bar:
-        result = run_experiment(cfg, config.parent, out_dir, name, bar, figures=not no_figures, resume=resume)
+        result = run_experiment(cfg, out_dir, name, bar, figures=not no_figures, resume=resume, jobs=jobs)
     problem = result.problem
     if result.explored:
         tracking = sum(s.metrics.tracks for s in result.explored)
@@ -112,12 +115,16 @@ def run(
                                                        f"{len(result.explored or result.solutions)} solves; "
                                                        "solution_set.csv)"))
     if result.best is None:
-        out.print("[yellow]No start tracks the path within tolerance; see summary.csv for statuses.[/yellow]")
+        statuses = ", ".join(sorted({s.raw.status for s in result.solutions})) or "none"
+        err.print(f"[red]no design tracks the path[/red] within {problem.position_tol:g} m and axis "
+                  f"{problem.axis_tol:g} (full-path statuses: {statuses}); see {result.directory.path / 'summary.csv'}",
+                  highlight=False)
     else:
         b = result.best
         placement = b.chain.placement_values([0.0] * b.chain.n_moving, [])
-        out.print(f"best: seed {b.raw.seed}, design cost [bold]{b.metrics.design_cost:.6g}[/bold], "
-                  f"placement xyz = ({placement[0]:.3f}, {placement[1]:.3f}, {placement[2]:.3f}) m")
+        out.print(f"best: seed {b.raw.seed} ({b.raw.status}, {b.raw.iterations} iterations), design cost "
+                  f"[bold]{b.metrics.design_cost:.6g}[/bold], placement xyz = ({placement[0]:.3f}, {placement[1]:.3f}, "
+                  f"{placement[2]:.3f}) m")
         if urdf:
             from designopt.export import export as export_cell
             from designopt.solution import to_dict
@@ -125,6 +132,8 @@ def run(
             for p in export_cell(to_dict(b), result.directory.path / "export", stem="best"):
                 out.print(f"wrote {p}")
     out.print(f"results: {result.directory.path}")
+    if result.best is None:
+        raise typer.Exit(code=3)
 
 
 @app.command()
@@ -134,7 +143,7 @@ def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/
     from designopt.experiments.check import check_config
 
     cfg = load(config)
-    s = check_config(cfg, config.parent)
+    s = check_config(cfg)
     joints = Table(title=f"{s.name}: {s.structure}, {len(s.design)} design joints, {len(s.moving)} moving, "
                          f"{s.n_fixed} fixed")
     for col in ("joint", "role", "start", "lower", "upper", "unit"):
@@ -189,7 +198,7 @@ class Bar:
 
     def solved(self, task, solution) -> None:
         self.failed += not solution.metrics.tracks
-        where = " ".join(x for x in (task.case, task.problem.chain.structure) if x)
+        where = " ".join(x for x in (task.case, task.stage, task.problem.chain.structure) if x)
         self.bar.update(self.task, advance=1, description=f"{self.label} {where}: {self.failed} not tracking")
 
 
@@ -207,6 +216,15 @@ OutOpt = Annotated[Path, typer.Option("--out", help="Root of the results tree.")
 NameOpt = Annotated[str | None, typer.Option("--name", help="Run name (default: a timestamp).")]
 ResumeOpt = Annotated[bool, typer.Option("--resume", help="Finish the run --name: keep its finished solves, "
                                                           "solve the rest.")]
+JobsOpt = Annotated[int, typer.Option("--jobs", help="Worker processes (-1: every core).")]
+
+
+def _names(text: str, allowed, option: str) -> tuple[str, ...]:
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    unknown = [n for n in names if n not in allowed]
+    if unknown or not names:
+        fail(f"{option}: {unknown[0] if unknown else '(empty)'!r} is not one of {', '.join(allowed)}")
+    return names
 
 
 @app.command()
@@ -216,13 +234,21 @@ def continuous(
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
     resume: ResumeOpt = False,
+    jobs: JobsOpt = -1,
+    cases: Annotated[str, typer.Option("--cases", help="Comma-separated: placement_only, design_only, combined.")]
+    = "placement_only,design_only,combined",
+    methods: Annotated[str, typer.Option("--methods", help="Comma-separated: to, fk, fk_continuous.")]
+    = "to,fk,fk_continuous",
 ):
     """Continuous design problem: placement only, design only, combined x TO, FK, FK with bounded steps."""
-    from designopt.experiments.continuous import run_continuous
+    from designopt.experiments.adapters import CASES
+    from designopt.experiments.continuous import METHODS, run_continuous
 
+    case_names, method_names = _names(cases, CASES, "--cases"), _names(methods, METHODS, "--methods")
     cfg = load(config)
     with Bar("continuous") as bar:
-        result = run_continuous(cfg, config.parent, out_dir, name, bar, resume=resume)
+        result = run_continuous(cfg, out_dir, name, bar, resume=resume, jobs=jobs, cases=case_names,
+                                methods=method_names)
     cols = ["case", "method", "n_design_joints", "design_cost", "max_joint_step", "tracking_starts", "starts",
             "median_solve_time_s"]
     show(_frame_table(result.table[cols], "best tracking start per case and method"))
@@ -236,13 +262,22 @@ def waypoints(
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
     resume: ResumeOpt = False,
+    jobs: JobsOpt = -1,
+    counts: Annotated[str, typer.Option("--waypoints", help="Comma-separated waypoint counts (3..2000).")]
+    = "20,40,80,160,320",
 ):
     """Waypoint study: design cost, tracking between waypoints and solve time against N (TO, combined)."""
     from designopt.experiments.waypoints import run_waypoint_study
 
+    try:
+        ns = tuple(int(n) for n in counts.split(","))
+    except ValueError:
+        fail(f"--waypoints: expected comma-separated integers, got {counts!r}")
+    if not ns or any(not 3 <= n <= 2000 for n in ns):
+        fail(f"--waypoints: every count must lie in 3..2000, got {counts!r}")
     cfg = load(config)
     with Bar("waypoint study") as bar:
-        result = run_waypoint_study(cfg, config.parent, out_dir, name, bar, resume=resume)
+        result = run_waypoint_study(cfg, out_dir, name, bar, resume=resume, jobs=jobs, waypoints=ns)
     show(_frame_table(result.table, "waypoint study (TO, design + placement)"))
     out.print(f"results: {result.directory.path}")
 
@@ -262,14 +297,15 @@ def sweep_structures(
     scheduler: Annotated[str | None, typer.Option("--scheduler", help="dask scheduler address, e.g. tcp://host:8786 "
                                                                        "(none: a LocalCluster).")] = None,
 ):
-    """Solve every kinematic structure over {R, P} with min..max joints (TO + multistart), in parallel."""
+    """Search every kinematic structure over {R, P} with min..max joints (the config's search, plus starts from
+    neighbouring structures' better designs), in parallel."""
     from designopt.experiments.sweep import run_sweep
 
     if backend not in ("loky", "dask"):
         fail(f"--backend: expected loky or dask, got {backend!r}")
     cfg = load(config)
     with Bar("structures") as bar:
-        result = run_sweep(cfg, config.parent, out_dir, name, min_dof, max_dof, jobs, resume, backend, scheduler, bar)
+        result = run_sweep(cfg, out_dir, name, min_dof, max_dof, jobs, resume, backend, scheduler, bar)
     tracking = int(result.table["design_cost"].notna().sum())
     out.print(f"{result.structures} structures solved ({result.solved_now} solves now, {result.already_done} "
               f"already done), {tracking} track the path; best per number of joints:")
@@ -285,13 +321,16 @@ def modular(
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
     resume: ResumeOpt = False,
+    jobs: JobsOpt = -1,
+    weight: Annotated[float, typer.Option("--weight", min=0.0, help="Weight of L_mod in the objective.")] = 1.0e-3,
 ):
-    """Modular design: continuous TO with L_mod, round links to modules, re-solve placement (+ FK, plain TO)."""
+    """Modular design: continuous TO with L_mod, round links to modules, re-solve placement, search neighbouring
+    assignments (+ FK, plain TO)."""
     from designopt.experiments.modular import run_modular
 
     cfg = load(config)
     with Bar("modular") as bar:
-        result = run_modular(cfg, config.parent, out_dir, name, bar, resume=resume)
+        result = run_modular(cfg, out_dir, name, bar, resume=resume, jobs=jobs, weight=weight)
     show(_frame_table(result.table, "modular design: best tracking start per stage"))
     out.print(f"results: {result.directory.path}")
 
@@ -303,13 +342,14 @@ def modular_study(
     out_dir: OutOpt = Path("results"),
     name: NameOpt = None,
     resume: ResumeOpt = False,
+    jobs: JobsOpt = -1,
 ):
     """Beyond the paper: the L_mod weight study, and every module assignment of a small catalogue."""
     from designopt.experiments.modular import run_modular_study
 
     cfg = load(config)
     with Bar("modular study") as bar:
-        result = run_modular_study(cfg, config.parent, out_dir, name, bar, resume=resume)
+        result = run_modular_study(cfg, out_dir, name, bar, resume=resume, jobs=jobs)
     enum = result.enumeration
     show(_frame_table(result.weights, "L_mod weight study"))
     show(_frame_table(enum.head(10), "best module assignments (small catalogue)"))

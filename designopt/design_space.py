@@ -112,6 +112,38 @@ def build_chain(
                  dh=tuple(links))
 
 
+def design_joint_names(chain: Chain, design: Sequence[str]) -> set[str]:
+    """The joints of ``chain`` that ``design`` makes design joints -- robot and placement alike.
+
+    Each item is a DH parameter name (``theta``, ``d``, ``a``, ``alpha``: that parameter of every link; on a P link
+    a requested ``d`` is its ``theta``, SPEC §4), ``placement`` (all six placement coordinates) or one of them
+    (``x`` ... ``roll``), or the name of any joint of the chain (``link2.a``, ``placement.yaw``,
+    ``elbow_joint.origin.z``). A moving joint is never a design joint. KeyError (with the reason) for an item that
+    names nothing."""
+    by_name = {j.name: j for j in chain.joints}
+    out: set[str] = set()
+    for item in design:
+        if item in DH_PARAMS:
+            if chain.dh is None:
+                raise KeyError(f"{item!r} names a DH parameter, and this robot is not a DH table: name joints of the "
+                               "chain (e.g. <urdf joint>.origin.z) or the placement")
+            for i, link_type in enumerate(chain.structure):
+                out |= {f"link{i + 1}.{p}" for p in resolve_design_params(link_type, [item])}
+        elif item == "placement":
+            out |= {j.name for j in chain.placement_joints}
+        elif item in PLACEMENT_PARAMS:
+            out.add(f"placement.{item}")
+        elif item in by_name:
+            if by_name[item].role is Role.MOVING:
+                raise KeyError(f"{item!r} is a moving joint: it follows a trajectory, it cannot be a design joint")
+            out.add(item)
+        else:
+            raise KeyError(f"{item!r} names no joint (a DH parameter theta/d/a/alpha, placement or one of "
+                           f"{', '.join(PLACEMENT_PARAMS)}, or a joint of the chain such as "
+                           f"{next((n for n in by_name if not n.startswith('placement')), 'link1.a')})")
+    return out
+
+
 def enumerate_structures(min_dof: int = 1, max_dof: int = 6) -> list[str]:
     """All strings over {R, P} with min_dof..max_dof letters: by length, then R before P at each place.
     1..6 gives 2 + 4 + ... + 64 = 126."""

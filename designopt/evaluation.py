@@ -62,25 +62,22 @@ def max_joint_step(Q: np.ndarray) -> float:
     return float(np.max(np.abs(np.diff(Q, axis=0))))
 
 
-def trajectory_clearance(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, V: np.ndarray | None):
-    """The cell's smallest clearance at the waypoints and, given velocities V, at the collocation points
-    between them (the midpoints of the cubic Hermite segments)."""
-    from designopt.transcriptions.collocation import hermite_midpoint
-
-    configurations, indices = np.asarray(Q, dtype=float), np.arange(len(Q), dtype=float)
-    if V is not None:
-        h = problem.toolpath.h[:, None]
-        Q_mid, _ = hermite_midpoint(Q[:-1], V[:-1], Q[1:], V[1:], h)
-        configurations = np.vstack([configurations, Q_mid])
-        indices = np.concatenate([indices, np.arange(len(Q) - 1) + 0.5])
+def trajectory_clearance(problem: DesignProblem, q_d: np.ndarray, trajectory):
+    """The cell's smallest clearance at the waypoints and at the trajectory's collocation points between them
+    (time_index k + 0.5 for the point after waypoint k)."""
+    Q = np.asarray(trajectory.Q, dtype=float)
+    t_mid, Q_mid = trajectory.collocation_points()
+    configurations = np.vstack([Q, Q_mid]) if len(Q_mid) else Q
+    indices = np.concatenate([np.arange(len(Q), dtype=float), np.arange(len(Q_mid)) + 0.5])
     return min_clearance(problem.chain, problem.cell, q_d, configurations, indices)
 
 
-def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, V: np.ndarray | None = None) -> Metrics:
-    """Evaluate a design q_d (n_d) and joint waypoints Q (N x n_m) on the problem's toolpath (V, the joint
-    velocities at the waypoints, places the collocation points for the clearance check)."""
+def evaluate(problem: DesignProblem, q_d: np.ndarray, trajectory) -> Metrics:
+    """Evaluate a design q_d (n_d) and a joint trajectory (`designopt.transcriptions.trajectory`; its knots are
+    the waypoints) on the problem's toolpath; the clearance is checked at its collocation points too."""
     chain, tp = problem.chain, problem.toolpath
     q_d = np.asarray(q_d, dtype=float)
+    Q = np.asarray(trajectory.Q, dtype=float)
     states = [problem.waypoint(Q[k], q_d, tp.points_W[k], tp.force_W[k]) for k in range(tp.n)]
     deform = np.array([deformation_term(w) for w in states])
     residuals = [tracking_residual(w) for w in states]
@@ -106,5 +103,5 @@ def evaluate(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, V: np.ndarr
         axis_error=axis_err,
         min_standoff=float(min(np.hypot(s[0], s[1]) for s in s_B)),
         costs=tuple(values.items()),
-        clearance=trajectory_clearance(problem, q_d, Q, V) if problem.cell is not None else None,
+        clearance=trajectory_clearance(problem, q_d, trajectory) if problem.cell is not None else None,
     )

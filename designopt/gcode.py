@@ -210,9 +210,10 @@ class SampledProgram:
     time_unit: str
 
 
-def sample_program(moves: list[Move], spacing: float, rapid_speed: float) -> SampledProgram:
+def sample_program(moves: list[Move], spacing: float, rapid_speed: float, origin=(0.0, 0.0, 0.0)) -> SampledProgram:
     """Waypoints spaced by arc length (at most ``spacing`` m apart, each move split evenly) from the start of
-    the first cutting move to the end of the last; rapids in between run at ``rapid_speed`` (m/s).
+    the first cutting move to the end of the last; rapids in between run at ``rapid_speed`` (m/s). ``origin`` is
+    where the program's zero lies in W (m): every point is shifted by it.
 
     A waypoint is tracked when it lies on a cutting move (the ends of a cut included). Its tangent is the
     direction of the move that leaves it (the last waypoint: of the move that arrives).
@@ -252,7 +253,7 @@ def sample_program(moves: list[Move], spacing: float, rapid_speed: float) -> Sam
     # where a cut ends and a rapid leaves, the cut's force follows the cut: take the arriving direction
     ends = np.flatnonzero(tracked[1:-1] & ~tracked[2:]) + 1
     tangents[ends] = tangents[ends - 1]
-    points, t = np.array(points), np.array(times)
+    points, t = np.array(points) + np.asarray(origin, dtype=float), np.array(times)
     if not timed:
         t = t / t[-1]
     return SampledProgram(points, t, tangents, tracked, "s" if timed else "task")

@@ -15,8 +15,16 @@ METHOD_LABELS = {"to": "TO (collocation)", "fk": "FK (Whitman et al.)", "fk_cont
 CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
 
 
+def full_path(summary: pd.DataFrame) -> pd.DataFrame:
+    """The rows of full-path solves (not the coarse stages of a search: `designopt.tables.COARSE_STAGES`)."""
+    from designopt.tables import COARSE_STAGES
+
+    return summary[~summary["stage"].isin(COARSE_STAGES)] if "stage" in summary else summary
+
+
 def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Path) -> list[Path]:
-    """Best design cost per case and method (bars), every tracking start (dots), max joint step (labels)."""
+    """Best design cost per case and method (bars), every tracking full-path solve (dots), max joint step (labels)."""
+    summary = full_path(summary)
     cases = [c for c in CASE_LABELS if c in set(table["case"])]
     methods = [m for m in METHOD_LABELS if m in set(table["method"])]
     fig, ax = plt.subplots(figsize=(7, 3.8))
@@ -34,7 +42,7 @@ def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Pa
                    label=METHOD_LABELS[method] if i == 0 else None)
             starts = summary[(summary["case"] == case) & (summary["method"] == method) & summary["tracks"]]
             ax.scatter(np.full(len(starts), x), starts["design_cost"], s=8, color="k", zorder=3,
-                       label="every tracking start" if (i == 0 and j == 0) else None)
+                       label="every tracking full-path solve" if (i == 0 and j == 0) else None)
             # above the bar and its dots, so that a short bar never cuts its label
             high = max([cost, *starts["design_cost"]])
             top = max(top, high)
@@ -99,7 +107,7 @@ def _ranked_bars(ax, rows: pd.DataFrame, title: str, starts: pd.DataFrame | None
         for i, structure in enumerate(rows["structure"]):
             costs = starts.loc[(starts["structure"] == structure) & starts["tracks"], "design_cost"]
             ax.scatter(np.full(len(costs), i), costs, s=6, color=style.COLORS["start"], zorder=3,
-                       label="every tracking start" if i == 0 else None)
+                       label="every tracking full-path solve" if i == 0 else None)
         ax.legend(fontsize=6)
     ax.set_xticks(range(len(rows)), rows["structure"], rotation=90, fontsize=7, family="monospace")
     ax.set_yscale("log")
@@ -109,7 +117,8 @@ def _ranked_bars(ax, rows: pd.DataFrame, title: str, starts: pd.DataFrame | None
 
 def structure_figures(table: pd.DataFrame, directory: Path, summary: pd.DataFrame | None = None) -> list[Path]:
     """The paper's structure figures plus best cost per number of joints; with the sweep's summary, every
-    start is shown beside each structure's best."""
+    full-path solve is shown beside each structure's best (coarse solves' costs are of another sampling)."""
+    summary = full_path(summary) if summary is not None else None
     paths = []
     six = table[table["dof"] == 6]
     if len(six):
@@ -117,7 +126,7 @@ def structure_figures(table: pd.DataFrame, directory: Path, summary: pd.DataFram
         if summary is not None:
             every = summary[(summary["dof"] == 6) & summary["tracks"]]
             ax.scatter(every["n_prismatic"] + 0.12, every["design_cost"], s=4, color=style.COLORS["other"],
-                       label="every tracking start")
+                       label="every tracking full-path solve")
         ax.scatter(six["n_prismatic"], six["design_cost"], s=14, alpha=0.6, label="each 6-DOF structure (best)")
         best = six.groupby("n_prismatic")["design_cost"].min()
         ax.plot(best.index, best.values, "o-", color="C3", label="best per number of P joints")
@@ -147,7 +156,7 @@ def structure_figures(table: pd.DataFrame, directory: Path, summary: pd.DataFram
         if summary is not None:
             every = summary[summary["tracks"]]
             ax.scatter(every["dof"] + 0.08, every["design_cost"], s=3, color=style.COLORS["other"],
-                       label="every tracking start")
+                       label="every tracking full-path solve")
         ax.semilogy(best["dof"], best["design_cost"], "o-", color=style.COLORS["robot"], label="best structure")
         for _, r in best.iterrows():
             ax.annotate(r["structure"], (r["dof"], r["design_cost"]), textcoords="offset points", xytext=(-6, 6),

@@ -17,7 +17,7 @@ import pandas as pd
 from designopt.errors import InputError
 
 SUMMARY_COLUMNS = [
-    "experiment", "case", "method", "structure", "dof", "n_prismatic", "n_design_joints",
+    "experiment", "case", "stage", "method", "structure", "dof", "n_prismatic", "n_design_joints",
     "design_cost", "max_position_error", "max_axis_error", "max_joint_step", "tracks", "best",
     "status", "success", "iterations", "solve_time_s", "build_time_s", "n_variables", "n_constraints",
     "objective", "regularization", "min_standoff", "kinematic_drift", "held", "seed",
@@ -122,15 +122,15 @@ class RunDirectory:
             writer.writerows(rows)
         os.replace(tmp, self.summary)
 
-    def resume(self) -> dict[tuple[str, str, str, int], dict]:
-        """The finished solves, by (case, method, structure, seed), ready to be resumed.
+    def resume(self) -> dict[tuple[str, str, str, str, int], dict]:
+        """The finished solves, by (case, stage, method, structure, seed), ready to be resumed.
 
         A row whose solution file is gone (or a second row for the same solve) is dropped from summary.csv,
         so the solve it stood for is done again and counted once."""
         fieldnames, rows = self._read_rows()
         kept: dict = {}
         for r in rows:
-            key = (r["case"], r["method"], r["structure"], int(r["seed"]))
+            key = _key(r)
             if key not in kept and r.get("solution_file") and (self.path / r["solution_file"]).is_file():
                 kept[key] = r
         if len(kept) < len(rows):
@@ -139,15 +139,20 @@ class RunDirectory:
         return kept
 
     def drop_rows(self, keys: set) -> None:
-        """Remove the rows of these (case, method, structure, seed) keys from summary.csv."""
+        """Remove the rows of these (case, stage, method, structure, seed) keys from summary.csv."""
         fieldnames, rows = self._read_rows()
-        keep = [r for r in rows if (r["case"], r["method"], r["structure"], int(r["seed"])) not in keys]
+        keep = [r for r in rows if _key(r) not in keys]
         self._rewrite(fieldnames, keep)
 
     def log(self, message: str) -> None:
         stamp = dt.datetime.now().isoformat(timespec="seconds")
         with (self.path / "run.log").open("a") as fh:
             fh.write(f"{stamp} {message}\n")
+
+
+def _key(row: dict) -> tuple[str, str, str, str, int]:
+    """(case, stage, method, structure, seed) of a summary row: what identifies a solve."""
+    return row["case"], row.get("stage") or "", row["method"], row["structure"], int(row["seed"])
 
 
 def _columns(row: dict) -> list[str]:

@@ -22,6 +22,7 @@ from designopt.evaluation import Metrics, evaluate
 from designopt.kinematics.joints import DH_PARAMS, Chain, Role
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import RawResult
+from designopt.transcriptions.trajectory import trajectory as make_trajectory
 
 SCHEMA = "designopt.solution/1"
 
@@ -34,7 +35,6 @@ class Solution:
     method: str
     raw: RawResult
     metrics: Metrics
-    label: str = ""
 
     @property
     def chain(self) -> Chain:
@@ -52,14 +52,21 @@ class Solution:
     @classmethod
     def from_dict(cls, data: dict, file="<solution>", checked: bool = False) -> Solution:
         """A solution file's content as a Solution: the solved chain (design joints fixed), its toolpath,
-        stiffness, tolerances and trajectory; metrics recomputed. The file's shape is checked by the one schema
-        check (`designopt.verify.check_schema`; skipped if ``checked``); SolutionFileError if it fails."""
+        stiffness, tolerances, the weights of its named cost terms and its trajectory; metrics recomputed. The
+        file's shape is checked by the one schema check (`designopt.verify.check_schema`; skipped if
+        ``checked``); SolutionFileError if it fails."""
         from designopt.toolpaths import Toolpath
         from designopt.verify import check_schema
 
         if not checked:
             check_schema(data, file)
         chain = chain_from_file(data)
+        # the design joints the file names are design joints again (at their solved values), so that the design
+        # terms (the regularisation) are recomputed as they were; a name the chain does not have (an origin
+        # component of a URDF robot, whose file carries elementary transforms) stays fixed
+        design = {n: float(v) for n, v in (data.get("design_joints") or {}).items()
+                  if n in {j.name for j in chain.joints}}
+        chain = chain.with_roles(dict.fromkeys(design, Role.DESIGN), design)
         tp = data["toolpath"]
         force = np.array(tp["force_W"], dtype=float)
         norms = np.linalg.norm(force, axis=1, keepdims=True)
@@ -78,40 +85,18 @@ class Solution:
                                 position_tol=tol.get("position", 1e-3), axis_tol=tol.get("axis", 1e-2),
                                 joint_velocity=float(limits[0].get("velocity_per_task_time", 10.0)),
                                 cell=cell_from_dict(data["cell"]) if "cell" in data else None)
-        raw = _raw_from_file(data, np.zeros(0))
-        return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, raw.Q, raw.V))
-
-    def _interval(self, t):
-        tk = self.problem.toolpath.t
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        k = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
-        h = (tk[k + 1] - tk[k])[:, None]
-        return k, h, (t[:, None] - tk[k][:, None]) / h
+        problem = _with_file_weights(problem, m.get("cost_weights") or {})
+        raw = _raw_from_file(data, chain.design_values, t)
+        return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, raw.trajectory))
 
     def sample(self, t) -> np.ndarray:
-        """Joint values q(t) (len(t) x n_m) at task times t in [0, 1].
-
-        Between waypoints the trajectory is the C^1 cubic Hermite spline through (q_k, v_k) when the solution
-        has joint velocities (TO's knots); without them (the FK baseline) it is the straight line, which is
-        all that baseline defines.
-        """
-        Q, V = np.asarray(self.raw.Q, float), self.raw.V
-        k, h, s = self._interval(t)
-        if V is None:
-            return Q[k] + s * (Q[k + 1] - Q[k])
-        V = np.asarray(V, float)
-        return ((2 * s**3 - 3 * s**2 + 1) * Q[k] + (s**3 - 2 * s**2 + s) * h * V[k]
-                + (-2 * s**3 + 3 * s**2) * Q[k + 1] + (s**3 - s**2) * h * V[k + 1])
+        """Joint values q(t) (len(t) x n_m) at times t of the path: the solution's trajectory decides what lies
+        between the waypoints (`designopt.transcriptions.trajectory`)."""
+        return self.raw.trajectory.sample(t)
 
     def sample_velocity(self, t) -> np.ndarray:
         """Joint velocities dq/dt (len(t) x n_m, per unit of the path's time) of `sample`'s trajectory."""
-        Q, V = np.asarray(self.raw.Q, float), self.raw.V
-        k, h, s = self._interval(t)
-        if V is None:
-            return (Q[k + 1] - Q[k]) / h
-        V = np.asarray(V, float)
-        return ((6 * s**2 - 6 * s) * (Q[k] - Q[k + 1]) / h + (3 * s**2 - 4 * s + 1) * V[k]
-                + (3 * s**2 - 2 * s) * V[k + 1])
+        return self.raw.trajectory.velocity(t)
 
     def row(self) -> dict:
         """One summary.csv row (without experiment/case columns, which the caller adds)."""
@@ -141,8 +126,16 @@ class Solution:
         }
 
 
-def solve_and_evaluate(problem: DesignProblem, method: str, raw: RawResult, label: str = "") -> Solution:
-    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.Q, raw.V), label)
+def solve_and_evaluate(problem: DesignProblem, method: str, raw: RawResult) -> Solution:
+    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.trajectory))
+
+
+def _with_file_weights(problem: DesignProblem, weights: dict) -> DesignProblem:
+    """The problem with the weights a file states for its named terms (a term the file does not name keeps
+    the default; a term the problem does not have cannot be rebuilt from a file and stays out)."""
+    waypoint = tuple(replace(c, weight=float(weights.get(c.name, c.weight))) for c in problem.waypoint_costs)
+    design = tuple(replace(c, weight=float(weights.get(c.name, c.weight))) for c in problem.design_costs)
+    return replace(problem, waypoint_costs=waypoint, design_costs=design)
 
 
 def _finite(x: float) -> float | None:
@@ -216,9 +209,10 @@ def to_dict(sol: Solution) -> dict:
         },
         **({"cell": cell_to_dict(p.cell)} if p.cell is not None else {}),
         "q": np.asarray(r.Q).tolist(),
-        # joint velocities dq/dt at the waypoints (TO's Hermite knots; absent for FK): with q they define
-        # the trajectory between waypoints
+        # joint velocities dq/dt at the waypoints (TO's Hermite knots; absent for FK): with q and the trajectory's
+        # kind they define the trajectory between waypoints
         **({"v": np.asarray(r.V).tolist()} if r.V is not None else {}),
+        "trajectory": r.trajectory.kind,
         "joint_limits": [{"name": j.name, "lower": j.lower, "upper": j.upper, "velocity_per_task_time":
                           p.joint_velocity} for j in p.chain.moving],
         "design_joints": {j.name: float(v) for j, v in zip(p.chain.design, r.q_d, strict=True)},
@@ -272,7 +266,7 @@ class SolutionLoadError(ValueError):
     """A solution file that cannot stand for a solve of the given problem (missing, malformed, other problem)."""
 
 
-def read_solution_for(problem: DesignProblem, method: str, path: Path, label: str = "") -> Solution:
+def read_solution_for(problem: DesignProblem, transcription, path: Path) -> Solution:
     """Load a solution this problem's solve wrote earlier (to resume a run): the design joints and the joint
     trajectory from the file, the metrics recomputed on the problem.
 
@@ -282,24 +276,27 @@ def read_solution_for(problem: DesignProblem, method: str, path: Path, label: st
     try:
         data = json.loads(Path(path).read_text())
         names = [j.name for j in problem.chain.design]
-        raw = _raw_from_file(data, np.array([data["design_joints"][n] for n in names], dtype=float))
+        raw = _raw_from_file(data, np.array([data["design_joints"][n] for n in names], dtype=float), problem.toolpath.t)
         if set(data["design_joints"]) != set(names) or raw.Q.shape != (problem.toolpath.n, problem.chain.n_moving):
             raise SolutionLoadError(f"{path}: written for another problem")
-        if method == "to" and raw.V is None:
-            raise SolutionLoadError(f"{path}: no joint velocities (written before they were stored)")
+        if raw.trajectory.kind != transcription.trajectory_kind:
+            raise SolutionLoadError(f"{path}: a {raw.trajectory.kind} trajectory where {transcription.name} makes a "
+                                    f"{transcription.trajectory_kind} one")
     except (OSError, ValueError, KeyError, TypeError) as exc:
         if isinstance(exc, SolutionLoadError):
             raise
         raise SolutionLoadError(f"{path}: {exc}") from None
-    return Solution(problem, method, raw, evaluate(problem, raw.q_d, raw.Q, raw.V), label)
+    return Solution(problem, transcription.name, raw, evaluate(problem, raw.q_d, raw.trajectory))
 
 
-def _raw_from_file(data: dict, q_d: np.ndarray) -> RawResult:
-    """The solver's answer as a solution file records it (its metrics block), with these design joints."""
+def _raw_from_file(data: dict, q_d: np.ndarray, t: np.ndarray) -> RawResult:
+    """The solver's answer as a solution file records it (its metrics block), with these design joints; ``t`` are
+    the waypoint times of the trajectory's knots."""
     m = data["metrics"]
     objective = m.get("objective")
-    return RawResult(q_d=q_d, Q=np.array(data["q"], dtype=float),
-                     V=np.array(data["v"], dtype=float) if "v" in data else None,
+    trajectory = make_trajectory(t, np.array(data["q"], dtype=float),
+                                 np.array(data["v"], dtype=float) if "v" in data else None, data.get("trajectory"))
+    return RawResult(q_d=q_d, trajectory=trajectory,
                      status=str(m.get("status", "unknown")), success=bool(m.get("success", False)),
                      iterations=int(m.get("iterations", 0)), solve_time_s=float(m.get("solve_time_s", 0.0)),
                      build_time_s=float(m.get("build_time_s", 0.0)),

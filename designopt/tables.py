@@ -7,8 +7,7 @@ import numpy as np
 import pandas as pd
 
 from designopt.design_space import enumerate_structures
-from designopt.multistart import best_solution
-from designopt.search import cluster_designs
+from designopt.solve.optima import best_solution, cluster_designs
 
 CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
 
@@ -40,10 +39,12 @@ def best_per_dof(table: pd.DataFrame) -> pd.DataFrame:
     return tracking.groupby("dof").head(1).sort_values("dof")
 
 
-def _stage_of(case) -> str:
-    """The search stage of a summary row: explore, screen, or final (refine, or a plain multistart start)."""
-    case = str(case)
-    return next((st for st in ("explore", "screen") if case == st or case.endswith("-" + st)), "final")
+COARSE_STAGES = ("explore", "screen")  # solves on a coarser sampling of the path; every other stage is full-path
+
+
+def _stage_of(stage) -> str:
+    """explore, screen, or final (any full-path stage: refine, a multistart start, a neighbour start)."""
+    return stage if stage in COARSE_STAGES else "final"
 
 
 def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
@@ -51,7 +52,7 @@ def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
     reached within 5 % of it (``near_best``) and, for a coarse-to-fine search, how many exploration solves came
     within 5 % of the exploration's best (``explore_near_best`` of ``explore_starts``); statuses."""
     rows = []
-    stage = summary["case"].map(_stage_of) if "case" in summary else pd.Series("final", index=summary.index)
+    stage = summary["stage"].map(_stage_of) if "stage" in summary else pd.Series("final", index=summary.index)
     tracks = summary["tracks"].astype(str) == "True"
     for structure, group in summary.groupby("structure", sort=False):
         final = group[stage[group.index] == "final"]

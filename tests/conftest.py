@@ -1,4 +1,5 @@
-"""Shared fixtures: tiny problems whose answers are known independently of designopt."""
+"""Shared fixtures: tiny problems whose answers are known independently of designopt, and the shortest way to
+solve one of them."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import pytest
 
 from designopt.config import parse_config
 from designopt.problem import problem_from_config
+from designopt.solve import Seeded, SolverProfile, solve_guess, solve_one
 
 # A Cartesian gantry in standard DH: link 1 moves along z0, link 2 along z1 = y0, link 3 along z2 = x0.
 GANTRY_DH = [
@@ -19,17 +21,38 @@ GANTRY_DH = [
 
 
 def gantry_config(**overrides) -> dict:
-    """PPP gantry milling a short line, workpiece rotated so its -z axis is reachable by the tool."""
+    """PPP gantry milling a short line, workpiece rotated so its -z axis is reachable by the tool; the offsets a
+    of every link are the design joints, the placement is fixed."""
     cfg = {
         "name": "gantry",
+        "design": ["a"],
         "toolpath": {"kind": "line", "length": 0.2, "waypoints": 12, "force": 2.0},
-        "robot": {"structure": "PPP", "design": ["a"], "dh": GANTRY_DH, "bounds": {"prismatic": [-2, 2]}},
-        "placement": {"optimize": False, "xyz": [0.3, 0.2, 0.5], "ypr": [0.0, -math.pi / 2, 0.0]},
-        "solver": {"multistart": 1, "max_iter": 200},
+        "robot": {"structure": "PPP", "dh": GANTRY_DH},
+        "placement": {"xyz": [0.3, 0.2, 0.5], "ypr": [0.0, -math.pi / 2, 0.0]},
+        "search": {"preset": "paper", "starts": 1},
     }
     for key, value in overrides.items():
         cfg[key] = {**cfg.get(key, {}), **value} if isinstance(value, dict) else value
     return cfg
+
+
+def solve(problem, transcription=None, index: int = 0, seed: int = 0, init: str = "ik", max_iter: int = 1000,
+          hold_degenerate: bool = True, **profile):
+    """Start ``index`` of seed ``seed`` of ``problem`` solved (TO unless ``transcription``), as a Solution."""
+    return solve_one(problem, Seeded(seed, index, init=init), transcription,
+                     SolverProfile(max_iter=max_iter, **profile), hold_degenerate)
+
+
+def solve_from(problem, guess, transcription=None, max_iter: int = 1000, **profile):
+    """``problem`` solved from an explicit InitialGuess (no continuation)."""
+    from designopt.transcriptions import Collocation
+
+    return solve_guess(problem, transcription or Collocation(), SolverProfile(max_iter=max_iter, **profile), guess)
+
+
+def config(data: dict, base_dir=None):
+    """A parsed config (relative files against ``base_dir``)."""
+    return parse_config(data, "<test>", base_dir)
 
 
 @pytest.fixture

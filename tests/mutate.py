@@ -29,10 +29,13 @@ TESTS = ["tests/test_objective_truth.py", "tests/test_costs_and_toolpaths.py", "
 
 @dataclass(frozen=True)
 class Mutation:
+    """A one-line bug; ``tests`` (default: `TESTS`) are the tests that must notice it."""
+
     name: str
     file: str
     old: str
     new: str
+    tests: tuple[str, ...] | None = None
 
 
 MUTATIONS = [
@@ -71,7 +74,7 @@ MUTATIONS = [
     Mutation("rotation about a general axis turned the wrong way", "designopt/kinematics/transforms.py",
              "[c + x * x * v, x * y * v - z * s, x * z * v + y * s, 0],",
              "[c + x * x * v, x * y * v + z * s, x * z * v + y * s, 0],"),
-    Mutation("smoothness integral off by the interval length", "designopt/transcriptions/collocation.py",
+    Mutation("smoothness integral off by the interval length", "designopt/transcriptions/trajectory.py",
              "return h / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)", "return 1 / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)"),
     Mutation("G2 and G3 swapped", "designopt/gcode.py",
              "period = -2 * math.pi if clockwise else 2 * math.pi",
@@ -93,12 +96,12 @@ MUTATIONS = [
     Mutation("per-joint stiffness read in reverse", "designopt/costs.py",
              "return np.array(self.per_joint, dtype=float)", "return np.array(self.per_joint[::-1], dtype=float)"),
     # the search (issue 11)
-    Mutation("search refines the most expensive coarse optima", "designopt/search.py",
+    Mutation("search refines the most expensive coarse optima", "designopt/solve/optima.py",
              "for k in np.argsort(costs, kind=\"stable\"):", "for k in np.argsort(-costs, kind=\"stable\"):"),
-    Mutation("lifted start drops the coarse design", "designopt/search.py",
+    Mutation("lifted start drops the coarse design", "designopt/solve/starts.py",
              "q_d=np.asarray(solution.raw.q_d, float)", "q_d=problem.chain.design_values"),
-    Mutation("screening ignores its iteration cap", "designopt/experiments/tasks.py",
-             "settings, search, search.screen_max_iter)", "settings, search)"),
+    Mutation("screening ignores its iteration cap", "designopt/solve/strategies/coarse_to_fine.py",
+             "search, search.screen_max_iter)", "search)"),
     # degenerate designs (issue 12, cause 3)
     Mutation("a moving target's row held once", "designopt/transcriptions/degeneracy.py",
              "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e-12:",
@@ -106,8 +109,46 @@ MUTATIONS = [
     Mutation("a gantry's own once-only rows count as degenerate", "designopt/transcriptions/degeneracy.py",
              "if len(q_independent_rows(candidate)) <= len(q_independent_rows(problem)):",
              "if len(q_independent_rows(candidate)) == 0:"),
-    Mutation("a stalled solve is continued without holding its angles", "designopt/multistart.py",
-             "more = _solve_built(held_problem, warm,", "more = _solve_built(problem, warm,"),
+    Mutation("a stalled solve is continued without holding its angles", "designopt/solve/strategies/continuation.py",
+             "more = solve_guess(problem, task.transcription,", "more = solve_guess(task.problem, task.transcription,"),
+    Mutation("the degenerate-design watch is not attached", "designopt/solve/strategies/steps.py",
+             "return profile.observing(HoldDegenerate.observer), HoldDegenerate()",
+             "return profile, HoldDegenerate()"),
+    # issue 22: classes of bugs the suite used to miss
+    Mutation("verify compares a reported error with itself", "designopt/verify.py",
+             "if not np.isclose(check.max_axis_error, m[\"max_axis_error\"], rtol=1e-6, atol=1e-12):",
+             "if not np.isclose(m[\"max_axis_error\"], m[\"max_axis_error\"], rtol=1e-6, atol=1e-12):",
+             ("tests/test_bad_inputs.py",)),
+    Mutation("verify compares the reported clearance with itself", "designopt/verify.py",
+             "if reported is None or not np.isclose(value, reported, rtol=0.0, atol=1e-6):",
+             "if reported is None or not np.isclose(reported, reported, rtol=0.0, atol=1e-6):",
+             ("tests/test_clearance.py",)),
+    Mutation("a config key read and ignored (the stand-off)", "designopt/problem.py",
+             "keep_out_radius=cfg.placement.keep_out_radius,", "keep_out_radius=0.0,", ("tests/test_config_keys.py",)),
+    Mutation("a search option of the config ignored (the seed)", "designopt/experiments/adapters.py",
+             "return preset(s.preset, seed=s.seed,", "return preset(s.preset, seed=0,", ("tests/test_config_keys.py",)),
+    Mutation("a search option of the config ignored (the starts)", "designopt/experiments/adapters.py",
+             "**({\"starts\": s.starts} if s.starts is not None else {})", "**{}",
+             ("tests/test_config_keys.py",)),
+    Mutation("modular rounding reads the configured design, not the solved one", "designopt/experiments/modular.py",
+             "assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)",
+             "assignment = nearest_modules(continuous.problem.chain, continuous.problem.chain.design_values, "
+             "catalogue)",
+             ("tests/test_modular.py",)),
+    Mutation("resume keeps a row whose solution file is gone", "designopt/results_io.py",
+             "if key not in kept and r.get(\"solution_file\") and (self.path / r[\"solution_file\"]).is_file():",
+             "if key not in kept and r.get(\"solution_file\"):",
+             ("tests/test_resume.py::test_a_row_without_its_solution_file_is_dropped_on_resume",)),
+    Mutation("URDF joints without limits take the other joint type's travel", "designopt/kinematics/urdf.py",
+             "lo, hi = bounds.revolute if motion == \"rotate\" else bounds.prismatic",
+             "lo, hi = bounds.prismatic if motion == \"rotate\" else bounds.revolute", ("tests/test_urdf.py",)),
+    Mutation("a solution file reads back with default cost weights", "designopt/solution.py",
+             "problem = _with_file_weights(problem, m.get(\"cost_weights\") or {})",
+             "problem = _with_file_weights(problem, {})", ("tests/test_transcriptions.py",)),
+    Mutation("a solution file's trajectory kind ignored", "designopt/solution.py",
+             "np.array(data[\"v\"], dtype=float) if \"v\" in data else None, data.get(\"trajectory\"))",
+             "np.array(data[\"v\"], dtype=float) if \"v\" in data else None, None)",
+             ("tests/test_transcriptions.py",)),
 ]
 
 
@@ -150,7 +191,8 @@ def main() -> int:
         cache, clean = tmp / "cache", tmp / "clean"
         copy_project(clean)
         start = time.perf_counter()
-        ok, summary = run_tests(clean, cache, args.tests)
+        targeted = [t for m in chosen if m.tests and args.tests == TESTS for t in m.tests]
+        ok, summary = run_tests(clean, cache, list(dict.fromkeys([*args.tests, *targeted])))
         print(f"baseline (no mutation): {'green' if ok else 'RED'} in {time.perf_counter() - start:.0f} s: {summary}")
         if not ok:
             print("the unmutated suite fails: fix it before judging mutations")
@@ -167,7 +209,7 @@ def main() -> int:
                 continue
             path.write_text(text.replace(m.old, m.new))
             start = time.perf_counter()
-            passed, summary = run_tests(tree, cache, args.tests)
+            passed, summary = run_tests(tree, cache, list(m.tests) if m.tests and args.tests == TESTS else args.tests)
             survived += passed
             verdict = "SURVIVED" if passed else "caught  "
             print(f"[{i:2d}] {verdict} {m.name} ({time.perf_counter() - start:.0f} s): {summary}", flush=True)

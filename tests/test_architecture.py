@@ -1,5 +1,5 @@
-"""The shape of the code: data flows one way (config -> problem -> transcription -> solution -> tables/plots ->
-experiments -> CLI), no import cycle anywhere, and the verifier depends on nothing of designopt."""
+"""The shape of the code: data flows one way (config -> problem -> transcription -> solution -> solve ->
+tables/plots -> experiments -> CLI), no import cycle anywhere, and the verifier depends on nothing of designopt."""
 
 from __future__ import annotations
 
@@ -16,7 +16,8 @@ LAYERS = [
     ("designopt.config",),
     ("designopt.problem",),
     ("designopt.transcriptions", "designopt.initial_guess"),
-    ("designopt.evaluation", "designopt.solution", "designopt.results_io", "designopt.multistart", "designopt.search"),
+    ("designopt.evaluation", "designopt.solution", "designopt.results_io"),
+    ("designopt.solve",),
     ("designopt.tables", "designopt.style", "designopt.plots", "designopt.plots_experiments", "designopt.export",
      "designopt.view"),
     ("designopt.experiments",),

@@ -37,26 +37,29 @@ BAD_INPUTS = [
     ("inf DH row", {"robot": {"dh": [{"d": ".inf"}, {}, {}]}}, None, "robot.dh[0].d", "finite"),
     ("NaN force", {"toolpath": {"force": ".nan"}}, None, "toolpath.force", "finite"),
     ("inf joint velocity", {"robot": {"joint_velocity": ".inf"}}, None, "robot.joint_velocity", "finite"),
-    ("NaN weight", {"costs": {"tracking_weight": ".nan"}}, None, "costs.tracking_weight", "finite"),
+    ("NaN weight", {"costs": {"regularization": ".nan"}}, None, "costs.regularization", "finite"),
     ("inf tolerance", {"tolerance": {"position": ".inf"}}, None, "tolerance.position", "finite"),
     ("zero tolerance", {"tolerance": {"axis": 0}}, None, "tolerance.axis", "greater than 0"),
-    ("bounds reversed", {"robot": {"bounds": {"prismatic": [2, -2]}}}, None, "robot.bounds.prismatic", "above"),
+    ("bounds reversed", {"robot": {"bounds": {"length": [2, 0.5]}}}, None, "robot.bounds.length", "lower <= upper"),
     ("box reversed", {"placement": {"box": [[1, -1], [-2, 2], [-1, 2]]}}, None, "placement.box.x", "above"),
     ("design start out of bounds", {"robot": {"bounds": {"length": [0.1, 2]}}}, None, "robot.dh[0].a",
      "outside its bounds"),
-    ("free angle out of range", {"placement": {"optimize": True, "ypr": [4.0, 0, 0]}}, None, "placement.ypr",
-     "[-pi, pi]"),
-    ("unreachable stand-off", {"placement": {"optimize": ["x"], "keep_out_radius": 10.0}}, None,
+    ("free angle out of range", {"design": ["a", "placement"], "placement": {"ypr": [4.0, 0, 0]}}, None,
+     "placement.ypr", "outside its bounds [-3.14159, 3.14159]"),
+    ("unreachable stand-off", {"design": ["x"], "placement": {"keep_out_radius": 10.0}}, None,
      "placement.keep_out_radius", "cannot be met"),
-    ("fixed placement inside stand-off", {"placement": {"keep_out_radius": 5.0}}, None,
+    ("fixed placement inside stand-off", {"design": ["d"], "placement": {"keep_out_radius": 5.0}}, None,
      "placement.keep_out_radius", "inside the stand-off"),
-    ("zero jobs", {"solver": {"jobs": 0}}, None, "solver.jobs", "0 workers"),
-    # found by the slow fuzz: IPOPT takes a 32-bit iteration limit (2^31 crashed it)
-    ("iteration cap beyond IPOPT's int", {"solver": {"max_iter": 2**31}}, None, "solver.max_iter", "less than"),
+    ("unknown design joint", {"design": ["d", "link9.a"]}, None, "design", "'link9.a' names no joint"),
+    ("a moving joint as a design joint", {"design": ["link1.d"]}, None, "design", "moving joint"),
+    ("search starts of zero", {"search": {"starts": 0}}, None, "search.starts", "greater than or equal to 1"),
+    ("unknown search preset", {"search": {"preset": "fast"}}, None, "search.preset", "'quick'"),
+    # a key of the old shape names what replaced it
+    ("old solver block", {"solver": {"multistart": 4}}, None, "solver", "search: {preset"),
+    ("old placement.optimize", {"placement": {"optimize": True}}, None, "placement.optimize", "moved to design"),
     ("too few waypoints", {"toolpath": {"kind": "line", "waypoints": 2}}, None, "toolpath.waypoints", "3"),
     ("zero-size path", {"toolpath": {"length": 1e-300}}, None, "toolpath", "zero speed"),
-    ("module index beyond catalogue", {"modular": {"enumeration_modules": [9]}}, None,
-     "modular.enumeration_modules", "does not exist"),
+    ("empty module catalogue", {"modules": []}, None, "modules", "at least 1"),
 ]
 
 
@@ -67,7 +70,7 @@ def write_case(tmp_path, overrides, csv_text):
         csv.write_bytes(csv_text if isinstance(csv_text, bytes) else csv_text.encode())
         cfg["toolpath"] = {"kind": "csv", "file": "path.csv"}
     for key, value in overrides.items():
-        cfg[key] = {**cfg.get(key, {}), **value}
+        cfg[key] = {**cfg.get(key, {}), **value} if isinstance(value, dict) else value
     path = tmp_path / "bad.yaml"
     # YAML's .nan/.inf must stay unquoted to be numbers
     path.write_text(yaml.safe_dump(cfg).replace("'.nan'", ".nan").replace("'.inf'", ".inf"))
@@ -95,8 +98,8 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path, command, name, overrides, cs
 
 @pytest.mark.parametrize("command", ["continuous", "waypoints", "modular", "modular-study"])
 def test_every_experiment_rejects_bad_input_with_one_line(tmp_path, command):
-    # the gantry is PPP: a catalogue of prismatic modules fits it, so the CSV is what is wrong
-    config, culprit = write_case(tmp_path, {"modular": {"joint_type": "P"}}, "x,y,z\n0,0,0\n0.1,abc,0\n0.2,0,0\n")
+    # the config is read (and its CSV with it) before anything else about the experiment is checked
+    config, culprit = write_case(tmp_path, {}, "x,y,z\n0,0,0\n0.1,abc,0\n0.2,0,0\n")
     result = runner.invoke(app, [command, str(config), "--out", str(tmp_path / "r")])
     assert result.exit_code == 2, result.output
     assert f"{culprit}: line 3: " in one_line(result)
@@ -137,10 +140,10 @@ def test_a_path_that_doubles_back_is_a_valid_task(tmp_path):
 def solution_file(tmp_path_factory):
     root = tmp_path_factory.mktemp("sol")
     config = root / "g.yaml"
-    cfg = gantry_config(solver={"multistart": 1, "jobs": 1})
-    cfg["placement"] = {**cfg["placement"], "optimize": ["x", "z"]}
+    cfg = gantry_config(design=["a", "x", "z"])
     config.write_text(yaml.safe_dump(cfg))
-    result = runner.invoke(app, ["run", str(config), "--out", str(root / "r"), "--name", "t", "--no-figures"])
+    result = runner.invoke(app, ["run", str(config), "--out", str(root / "r"), "--name", "t", "--no-figures",
+                                 "--jobs", "1"])
     assert result.exit_code == 0, result.output
     return root / "r" / "gantry" / "t" / "best.json"
 
@@ -159,6 +162,9 @@ TAMPERED = [
     ("force scaled", ("toolpath", "force_W", 3, 0), lambda v: 2 * v + 1, "force"),
     ("force_alpha edited", ("force_alpha",), lambda v: 2 * v, "force_alpha"),
     ("tracks flipped", ("metrics", "tracks"), lambda v: not v, "metrics.tracks"),
+    # each reported number is compared with its recomputation (not with itself)
+    ("position error edited", ("metrics", "max_position_error"), lambda v: v + 1e-4, "metrics.max_position_error"),
+    ("axis error edited", ("metrics", "max_axis_error"), lambda v: v + 1e-4, "metrics.max_axis_error"),
     ("cost edited", ("metrics", "design_cost"), lambda v: v * 1.001, "metrics.design_cost"),
     ("tolerance made infinite", ("metrics", "tolerances", "position"), 1e309, "metrics.tolerances.position"),
 ]

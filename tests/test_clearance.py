@@ -17,7 +17,8 @@ from designopt.config import parse_config
 from designopt.initial_guess import initial_guess
 from designopt.kinematics.chain import link_frames
 from designopt.problem import problem_from_config
-from designopt.solution import solve_and_evaluate, to_dict
+from designopt.solution import to_dict
+from designopt.solve import SolverProfile, solve_guess
 from designopt.transcriptions.collocation import Collocation
 from designopt.verify import clearance as coal_clearance
 from designopt.verify import problems
@@ -52,7 +53,7 @@ def test_segment_distance_matches_coal():
 
 
 def test_skeleton_follows_the_dh_links():
-    cfg = parse_config({"robot": {"structure": "RRRRRR", "dh": "puma560", "design": ["d", "a"]}})
+    cfg = parse_config({"robot": {"structure": "RRRRRR", "dh": "puma560"}, "design": ["d", "a"]})
     chain = problem_from_config(cfg).chain
     q = np.random.default_rng(0).uniform(-1, 1, 6)
     points, links = skeleton(chain, q, chain.design_values)
@@ -69,17 +70,16 @@ def _placement_problem(cell: bool):
     """A fixed PUMA-560; the workpiece's x and z are free. Without the cell, the least deflection puts the
     path where the forearm passes through the block under it."""
     cfg = parse_config({"toolpath": {"kind": "line", "length": 0.1, "waypoints": 8},
-                        "robot": {"structure": "RRRRRR", "dh": "puma560", "design": []},
-                        "placement": {"optimize": ["x", "z"], "xyz": [0.5, 0.0, -0.2]},
-                        "cell": {"block": {"size": [0.6, 0.6, 0.3]}, "floor": -1.5, "clearance": 0.01,
-                                 "link_radius": 0.05, "tool": {"length": 0.1}}})
+                        "robot": {"structure": "RRRRRR", "dh": "puma560"}, "design": ["x", "z"],
+                        "placement": {"xyz": [0.5, 0.0, -0.2]},
+                        "cell": {"block": [0.6, 0.6, 0.3], "floor": -1.5, "clearance": 0.01,
+                                 "link_radius": 0.05, "tool_length": 0.1}})
     problem = problem_from_config(cfg)
     return problem if cell else replace(problem, cell=None)
 
 
 def _solve(problem):
-    nlp = Collocation(max_iter=500).build(problem)
-    return solve_and_evaluate(problem, "to", nlp.solve(initial_guess(problem, 0, 0, 0.3, "ik")))
+    return solve_guess(problem, Collocation(), SolverProfile(max_iter=500), initial_guess(problem, 0, 0, 0.3, "ik"))
 
 
 def test_clearance_keeps_the_robot_out_of_the_block_and_costs_more():
@@ -96,12 +96,15 @@ def test_clearance_keeps_the_robot_out_of_the_block_and_costs_more():
     assert value >= with_cell.cell.clearance - 1e-6
     assert data["metrics"]["clearance"]["min"] == pytest.approx(value, abs=1e-6)
     assert problems(data) == []
+    data["metrics"]["clearance"]["min"] += 1e-4  # a reported clearance is checked against coal's, not itself
+    assert [key for key, _ in problems(data)] == ["metrics.clearance.min"]
     assert constrained.metrics.design_cost > free.metrics.design_cost
 
 
 @pytest.mark.parametrize(("cell", "key"), [
     ({"floor": -0.02}, "cell.floor"),
-    ({"tool": {"length": 0.03}}, "cell.tool.length"),
+    ({"tool_length": 0.03}, "cell.tool_length"),
+    ({"tool": {"length": 0.1}}, "cell.tool"),
     ({"link_radius": [0.05, 0.05]}, "cell.link_radius"),
     ({"clearance": -0.01}, "cell.clearance"),
 ])
@@ -117,17 +120,16 @@ def test_bad_cells_are_one_line_and_exit_2(tmp_path, cell, key):
 def test_per_joint_stiffness_reaches_the_deflection(tmp_path):
     """A per-joint list is the diagonal of K, checked by the standalone numpy recomputation of verify."""
     k = [2.0, 5.0, 0.5, 3.0, 1.5, 0.8]
-    cfg = parse_config({"robot": {"structure": "RRRRRR", "dh": "puma560", "design": [], "stiffness": k},
-                        "placement": {"optimize": False, "xyz": [0.45, 0.0, -0.2]},
+    cfg = parse_config({"robot": {"structure": "RRRRRR", "dh": "puma560", "stiffness": k}, "design": [],
+                        "placement": {"xyz": [0.45, 0.0, -0.2]},
                         "toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 12}})
     problem = problem_from_config(cfg)
     np.testing.assert_array_equal(problem.stiffness.diagonal("RRRRRR"), k)
     sol = _solve(problem)
     data = to_dict(sol)
     assert data["stiffness"] == k and problems(data) == []
-    bad = parse_config({"robot": {"stiffness": [1.0, 2.0]}}, tmp_path / "c.yaml")
     with pytest.raises(Exception, match="robot.stiffness: the list has 2 values but the robot has 6 moving joints"):
-        problem_from_config(bad)
+        parse_config({"robot": {"stiffness": [1.0, 2.0]}}, tmp_path / "c.yaml")
 
 
 def test_the_production_job_end_to_end(tmp_path):
@@ -143,10 +145,10 @@ def test_the_production_job_end_to_end(tmp_path):
     shutil.copy(root / "pocket.nc", tmp_path / "pocket.nc")
     cfg = yaml.safe_load((root / "gcode_pocket.yaml").read_text())
     cfg["toolpath"]["spacing"] = 0.006
-    cfg["solver"].update(multistart=1, jobs=1)
+    cfg["search"]["starts"] = 1
     (tmp_path / "pocket.yaml").write_text(yaml.safe_dump(cfg))
     result = CliRunner().invoke(app, ["run", str(tmp_path / "pocket.yaml"), "--out", str(tmp_path / "r"),
-                                      "--name", "t", "--urdf"])
+                                      "--name", "t", "--urdf", "--jobs", "1"])
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "gcode_pocket" / "t"
     data = json.loads((run / "best.json").read_text())
@@ -163,7 +165,7 @@ def test_the_production_job_end_to_end(tmp_path):
 def test_a_path_beside_the_block_is_a_config_error(tmp_path):
     import yaml
 
-    cfg = {"toolpath": {"kind": "line", "length": 0.5}, "cell": {"block": {"size": [0.2, 0.1, 0.05]}}}
+    cfg = {"toolpath": {"kind": "line", "length": 0.5}, "cell": {"block": [0.2, 0.1, 0.05]}}
     (tmp_path / "c.yaml").write_text(yaml.safe_dump(cfg))
     result = CliRunner().invoke(app, ["check", str(tmp_path / "c.yaml")])
     assert result.exit_code == 2 and len(result.output.strip().splitlines()) == 1

@@ -21,11 +21,9 @@ runner = CliRunner()
 def finished_run(tmp_path_factory):
     root = tmp_path_factory.mktemp("run")
     config = root / "gantry.yaml"
-    cfg = gantry_config(solver={"jobs": 1, "max_iter": 200,
-                                "search": {"explore_starts": 3, "explore_waypoints": 6, "refine": 2}})
-    cfg["placement"]["optimize"] = ["x", "z"]
+    cfg = gantry_config(design=["a", "x", "z"], search={"preset": "quick", "starts": 3})
     config.write_text(yaml.safe_dump(cfg))
-    result = runner.invoke(app, ["run", str(config), "--out", str(root / "results"), "--name", "t"])
+    result = runner.invoke(app, ["run", str(config), "--out", str(root / "results"), "--name", "t", "--jobs", "1"])
     return result, root / "results" / "gantry" / "t"
 
 
@@ -42,13 +40,13 @@ def test_run_writes_the_run_directory(finished_run):
     assert "Plotly.newPlot" in view and "Plotly.addFrames" in view  # animated, plotly.js inside
     assert not re.search(r"<script[^>]+src=[\"']https?://", view)  # nothing to fetch: opens offline
     summary = pd.read_csv(run / "summary.csv")
-    stages = summary["case"].value_counts()
+    stages = summary["stage"].value_counts()
     assert stages["explore"] == 3 and 1 <= stages["refine"] <= 2  # 3 coarse starts, the best 2 optima refined
-    required = ["experiment", "case", "method", "structure", "dof", "n_prismatic", "design_cost",
+    required = ["experiment", "case", "stage", "method", "structure", "dof", "n_prismatic", "design_cost",
                 "max_position_error", "max_axis_error", "max_joint_step", "tracks", "status", "iterations",
                 "solve_time_s", "seed", "solution_file"]
     assert set(required) <= set(summary.columns)
-    assert summary["best"].sum() == 1 and summary.loc[summary["best"], "case"].item() == "refine"
+    assert summary["best"].sum() == 1 and summary.loc[summary["best"], "stage"].item() == "refine"
     assert (summary["stiffness_revolute"] == 1.0).all()
 
 
@@ -117,11 +115,11 @@ def test_the_solution_set_is_an_output(finished_run):
     _, run = finished_run
     optima = pd.read_csv(run / "solution_set.csv")
     summary = pd.read_csv(run / "summary.csv")
-    explored = summary[summary["case"] == "explore"]
+    explored = summary[summary["stage"] == "explore"]
     assert optima["reached_by"].sum() == explored["tracks"].sum()  # the exploration's optima, each solve once
     assert optima["design_cost"].is_monotonic_increasing and optima["ratio_to_best"].iloc[0] == 1.0
     # every refined optimum carries its full-path cost, the one of the refine solve of its seed
-    refined = summary[summary["case"] == "refine"].set_index("seed")["design_cost"]
+    refined = summary[summary["stage"] == "refine"].set_index("seed")["design_cost"]
     with_cost = optima.dropna(subset=["full_path_cost"])
     assert len(with_cost) == len(refined)
     for _, row in with_cost.iterrows():

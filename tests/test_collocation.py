@@ -2,17 +2,26 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import casadi as ca
 import numpy as np
 import pytest
-from conftest import gantry_config
+from conftest import gantry_config, solve, solve_from
 
 from designopt.config import parse_config
 from designopt.initial_guess import initial_guesses
 from designopt.problem import problem_from_config
-from designopt.solution import solve_and_evaluate
+from designopt.solve import SolverProfile
+from designopt.solve.local import prepared
 from designopt.transcriptions import Collocation
-from designopt.transcriptions.collocation import hermite_acceleration_integral, hermite_midpoint
+from designopt.transcriptions.trajectory import hermite_acceleration_integral, hermite_midpoint
+
+
+def hessian_function(problem, transcription, compile="O0"):
+    """The nlp_hess_l of the prepared IPOPT solver of a problem."""
+    _, solver, _ = prepared(problem, transcription, SolverProfile(compile=compile))
+    return solver.solver.get_function("nlp_hess_l"), solver.nlp
 
 
 def test_hermite_formulas_match_the_cubic(rng):
@@ -33,10 +42,9 @@ def test_gantry_known_optimum():
     """A Cartesian gantry with K = I has J_v J_v^T = I, so C w = (F, 0) at every pose: L_d = alpha^2 and
     the design cost is alpha^2 N / (N - 1) for any design. The offsets a_i only pay regularisation, so the
     optimum has a = 0 (exactly so without the tiny joint regularisation, which trades against it)."""
-    problem = problem_from_config(parse_config(gantry_config(costs={"smoothness": 0.0, "joint_regularization": 0.0})))
-    nlp = Collocation().build(problem)
+    problem = replace(problem_from_config(parse_config(gantry_config())), smoothness=0.0, joint_regularization=0.0)
     guess = initial_guesses(problem, 1, seed=0, scale=0.3, mode="constant")[0]
-    sol = solve_and_evaluate(problem, "to", nlp.solve(guess))
+    sol = solve_from(problem, guess)
     N, alpha = problem.toolpath.n, 2.0
     assert sol.raw.success, sol.raw.status
     assert sol.metrics.tracks
@@ -52,11 +60,11 @@ def test_gantry_known_optimum():
 def test_soft_and_differential_variants_solve_the_gantry(tracking):
     problem = problem_from_config(parse_config(gantry_config()))
     for kinematics in ("forward", "differential"):
-        nlp = Collocation(tracking=tracking, kinematics=kinematics, hessian="auto" if kinematics ==
-                          "differential" else "structured").build(problem)
+        transcription = Collocation(tracking=tracking, kinematics=kinematics, hessian="auto" if kinematics ==
+                                    "differential" else "structured")
         guess = initial_guesses(problem, 1, 0, 0.3, "constant")[0]
-        raw = nlp.solve(guess)
-        sol = solve_and_evaluate(problem, "to", raw)
+        sol = solve_from(problem, guess, transcription, max_iter=3000)
+        raw = sol.raw
         assert raw.success, (tracking, kinematics, raw.status)
         # soft tracking leaves a residual of order 1/w; hard tracks exactly
         assert sol.metrics.max_position_error < (1e-6 if tracking == "hard" else 1e-3)
@@ -70,12 +78,10 @@ def test_structured_hessian_equals_casadi_hessian(tracking, keep_out, rng):
            "robot": {"structure": "RPRR", "dh": "generic"},
            "placement": {"xyz": [0.4, 0.1, 0.0], "keep_out_radius": keep_out}}
     problem = problem_from_config(parse_config(cfg))
-    ours = Collocation(tracking=tracking, hessian="structured", compile="none").build(problem)
-    ref = Collocation(tracking=tracking, hessian="auto").build(problem)
+    H_ours, ours = hessian_function(problem, Collocation(tracking=tracking, hessian="structured"), "none")
+    H_ref, ref = hessian_function(problem, Collocation(tracking=tracking, hessian="auto"))
     n_x, n_g = ours.n_variables, ours.n_constraints
     assert (n_x, n_g) == (ref.n_variables, ref.n_constraints)
-    H_ours = ours.solver.get_function("nlp_hess_l")
-    H_ref = ref.solver.get_function("nlp_hess_l")
     for _ in range(3):
         x, lam_f, lam_g = rng.normal(size=n_x), rng.uniform(0.5, 2), rng.normal(size=n_g)
         a = np.triu(np.array(ca.DM(H_ours(x, [], lam_f, lam_g))))
@@ -87,12 +93,12 @@ def test_compiled_block_gives_the_same_hessian(rng, tmp_path, monkeypatch):
     monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
     cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 5}, "robot": {"structure": "RR", "dh": "generic"}}
     problem = problem_from_config(parse_config(cfg))
-    a = Collocation(compile="O0").build(problem)
-    b = Collocation(compile="none").build(problem)
+    fa, a = hessian_function(problem, Collocation(), "O1")  # a level no other test asks for: compiled here
+    fb, _ = hessian_function(problem, Collocation(), "none")
     assert list(tmp_path.glob("*.so")), "the block function was not compiled"
     x, lam_g = rng.normal(size=a.n_variables), rng.normal(size=a.n_constraints)
-    Ha = np.array(ca.DM(a.solver.get_function("nlp_hess_l")(x, [], 1.0, lam_g)))
-    Hb = np.array(ca.DM(b.solver.get_function("nlp_hess_l")(x, [], 1.0, lam_g)))
+    Ha = np.array(ca.DM(fa(x, [], 1.0, lam_g)))
+    Hb = np.array(ca.DM(fb(x, [], 1.0, lam_g)))
     np.testing.assert_allclose(Ha, Hb, rtol=1e-12, atol=1e-12)
 
 
@@ -101,16 +107,16 @@ def test_ik_start_tracks_a_reachable_path():
            "placement": {"xyz": [0.45, 0.0, -0.2]}}
     problem = problem_from_config(parse_config(cfg))
     from designopt.evaluation import evaluate
+    from designopt.transcriptions.trajectory import PiecewiseLinear
 
     guess = initial_guesses(problem, 1, 0, 0.3, "ik")[0]
-    m = evaluate(problem, guess.q_d, guess.Q)
+    m = evaluate(problem, guess.q_d, PiecewiseLinear(problem.toolpath.t, guess.Q))
     assert m.max_position_error < 1e-6 and m.max_axis_error < 1e-6
     assert m.max_joint_step < 0.5  # one branch, no jumps
 
 
 def test_a_failed_solve_is_a_result_not_an_exception(gantry_problem):
-    nlp = Collocation(max_iter=2).build(gantry_problem)
-    raw = nlp.solve(initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0])
+    raw = solve_from(gantry_problem, initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0], max_iter=2).raw
     assert not raw.success
     assert raw.status == "Maximum_Iterations_Exceeded"
 
@@ -120,12 +126,11 @@ def test_axis_held_once_when_no_joint_turns_the_tool():
     problem is regular and IPOPT converges (it stalled at max_iter when they were repeated N times)."""
     from designopt.transcriptions.nlp import once_only_rows
 
-    problem = problem_from_config(parse_config(gantry_config(robot={"design": ["theta", "a", "alpha"]},
-                                                             placement={"optimize": True})))
+    problem = problem_from_config(parse_config(gantry_config(design=["theta", "a", "alpha", "placement"])))
     assert list(once_only_rows(problem, "hard")) == [3, 4, 5]
     assert len(once_only_rows(problem_from_config(parse_config({})), "hard")) == 0
-    raw = Collocation(max_iter=300).build(problem).solve(initial_guesses(problem, 1, 0, 0.1, "constant")[0])
-    sol = solve_and_evaluate(problem, "to", raw)
+    sol = solve_from(problem, initial_guesses(problem, 1, 0, 0.1, "constant")[0], max_iter=300)
+    raw = sol.raw
     assert raw.success, raw.status
     assert sol.metrics.tracks
 
@@ -145,8 +150,8 @@ def test_reach_moves_the_design_joints_until_the_start_reaches_the_path():
     by centimetres); `reach` (IK over the design joints too) finds a design near it that tracks, inside bounds."""
     from designopt.initial_guess import initial_guess, tracks
 
-    cfg = parse_config({"toolpath": {"kind": "figure_eight", "waypoints": 30},
-                        "placement": {"optimize": False, "xyz": [0.45, 0.0, -0.2]}})
+    cfg = parse_config({"toolpath": {"kind": "figure_eight", "waypoints": 30}, "design": ["d", "a", "alpha"],
+                        "placement": {"xyz": [0.45, 0.0, -0.2]}})
     problem = problem_from_config(cfg)
     plain, reached = initial_guess(problem, 1, 0, 0.3, "ik"), initial_guess(problem, 1, 0, 0.3, "reach")
     assert not tracks(problem, plain.q_d, plain.Q)
@@ -162,11 +167,8 @@ def test_reach_moves_the_design_joints_until_the_start_reaches_the_path():
 def test_build_time_is_counted_once_per_built_nlp():
     """A worker builds a problem's NLP for its first start and reuses it: only that start reports a build time
     (summing build_time_s over a sweep must give the time spent building)."""
-    from designopt.multistart import Multistart, solve_start
-
     # a force no other test uses, so that this problem is not in the worker's cache yet
     problem = problem_from_config(parse_config(gantry_config(toolpath={"force": 2.718281828})))
-    transcription, settings = Collocation(max_iter=50), Multistart(count=2, init="constant")
-    first, second = (solve_start(problem, transcription, settings, i) for i in range(2))
+    first, second = (solve(problem, index=i, init="constant", max_iter=50) for i in range(2))
     assert first.raw.build_time_s > 0
     assert second.raw.build_time_s == 0

@@ -15,14 +15,15 @@ CONFIGS = sorted(Path(__file__).resolve().parent.parent.joinpath("configs").glob
 @pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.name)
 def test_every_config_loads_and_builds(path):
     cfg = load_config(path)
-    problem = problem_from_config(cfg, path.parent)
+    problem = problem_from_config(cfg)
     assert problem.toolpath.n >= 3
     assert load_config(path) == parse_config(__import__("yaml").safe_load(dump_config(cfg)), path, path.parent)
 
 
 BAD = [
-    ("solver: {max_iter: 0}\n", "solver.max_iter", "greater than or equal to 1"),
-    ("solver: {max_iters: 10}\n", "solver.max_iters", "unknown key"),
+    ("search: {starts: 0}\n", "search.starts", "greater than or equal to 1"),
+    ("search: {starts_: 10}\n", "search.starts_", "unknown key"),
+    ("solver: {max_iter: 10}\n", "solver", "replaced by search"),
     ("robot: {stiffness: {revolute: -1}}\n", "robot.stiffness.revolute", "greater than 0"),
     ("robot: {structure: RRX}\n", "robot.structure", "pattern"),
     ("robot: {structure: RRR, dh: puma560}\n", "robot.dh", "6 links"),
@@ -31,7 +32,8 @@ BAD = [
     ("toolpath: {kind: circle, radius: big}\n", "toolpath.radius", "valid number"),
     ("toolpath: {kind: csv, file: nowhere.csv}\n", "toolpath.file", "no such file"),
     ("placement: {xyz: [5, 0, 0]}\n", "placement.xyz", "outside the box"),
-    ("placement: {optimize: [x, w]}\n", "placement.optimize[1]", "'x'"),
+    ("design: [x, w]\n", "design", "'w' names no joint"),
+    ("placement: {optimize: [x, w]}\n", "placement.optimize", "moved to design"),
     ("costs: {deflection: sideways}\n", "costs.deflection", "'full'"),
     ("- just\n- a list\n", "(top level)", "mapping"),
     ("name: [unclosed\n", "line 2", "malformed YAML"),

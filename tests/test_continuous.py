@@ -13,12 +13,17 @@ from designopt.verify import verify_file
 
 
 def test_cases_differ_only_in_roles():
+    from designopt.problem import problem_from_config
+
     cfg = parse_config({})
-    placement, design, combined = (case_config(cfg, c) for c in ("placement_only", "design_only", "combined"))
-    assert placement.robot.design == [] and placement.placement.optimize is True
-    assert design.robot.design == ["d", "a", "alpha"] and design.placement.optimize is False
-    assert combined.robot.design == ["d", "a", "alpha"] and combined.placement.optimize is True
-    assert placement.toolpath == design.toolpath == combined.toolpath
+    placement, design, combined = (problem_from_config(case_config(cfg, c)).chain
+                                   for c in ("placement_only", "design_only", "combined"))
+    assert {j.name.split(".")[0] for j in placement.design} == {"placement"} and placement.n_design == 6
+    assert {j.name.split(".")[1] for j in design.design} == {"d", "a", "alpha"} and design.n_design == 18
+    assert {j.name for j in combined.design} == {j.name for j in placement.design} | {j.name for j in design.design}
+    # the same joints with the same values: only the roles differ
+    assert [(j.name, j.value) for j in placement.joints] == [(j.name, j.value) for j in combined.joints]
+    assert case_config(cfg, "combined").toolpath == case_config(cfg, "design_only").toolpath == cfg.toolpath
 
 
 def test_continuous_experiment_small(tmp_path):
@@ -27,9 +32,10 @@ def test_continuous_experiment_small(tmp_path):
         "name": "continuous",
         "toolpath": {"kind": "figure_eight", "width": 0.6, "height": 0.3, "waypoints": 10},
         "placement": {"xyz": [0.45, 0.0, -0.2]},
-        "solver": {"multistart": 1, "max_iter": 300, "jobs": 2},
+        "search": {"preset": "paper", "starts": 1},
     }))
-    result = CliRunner().invoke(app, ["continuous", str(config), "--out", str(tmp_path / "r"), "--name", "t"])
+    result = CliRunner().invoke(app, ["continuous", str(config), "--out", str(tmp_path / "r"), "--name", "t",
+                                      "--jobs", "2"])
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "continuous" / "t"
     summary = pd.read_csv(run / "summary.csv")

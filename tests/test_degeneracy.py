@@ -10,23 +10,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import gantry_config
+from conftest import gantry_config, solve
 
 from designopt.config import parse_config
 from designopt.evaluation import evaluate
-from designopt.experiments.adapters import multistart_from_config, transcription_for
 from designopt.kinematics.chain import tool_pose
-from designopt.multistart import solve_start
 from designopt.problem import problem_from_config
-from designopt.transcriptions.degeneracy import DegenerateWatch, held_at_multiples_of_pi, q_independent_rows
+from designopt.solve import Search
+from designopt.solve.observers import DegenerateWatch
+from designopt.transcriptions.degeneracy import held_at_multiples_of_pi, q_independent_rows
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def design_only(waypoints: int = 12, max_iter: int = 400, hold: bool = True):
+def design_only(waypoints: int = 12):
     raw = yaml.safe_load((ROOT / "configs" / "design_only.yaml").read_text())
     raw["toolpath"]["waypoints"] = waypoints
-    raw["solver"] = {"max_iter": max_iter, "jobs": 1, "hold_degenerate": hold}
     cfg = parse_config(raw)
     return cfg, problem_from_config(cfg)
 
@@ -77,8 +76,7 @@ def test_holding_snaps_the_angles_near_a_multiple_of_pi_and_nothing_else():
     assert held_at_multiples_of_pi(problem, np.array([j.value for j in problem.chain.design])) is None
     # a PPP gantry's axis rows never depended on its joints (they are held once already): holding the angles of
     # its configured design that are multiples of pi frees no further row (its three axes stay orthogonal)
-    gantry = problem_from_config(parse_config(gantry_config(robot={"design": ["theta", "a", "alpha"]},
-                                                            placement={"optimize": True})))
+    gantry = problem_from_config(parse_config(gantry_config(design=["theta", "a", "alpha", "placement"])))
     assert list(q_independent_rows(gantry)) == [3, 4, 5]
     configured = np.array([j.value for j in gantry.chain.design])
     at_pi = np.array([j.kind == "angle" and abs(np.sin(j.value)) < 1e-12 for j in gantry.chain.design])
@@ -88,12 +86,10 @@ def test_holding_snaps_the_angles_near_a_multiple_of_pi_and_nothing_else():
 
 def test_the_watch_stops_only_a_solve_that_stays_on_a_degenerate_design():
     _, problem = design_only()
-    n_d = problem.chain.n_design
-    watch = DegenerateWatch(problem, n_x=n_d + 5, n_g=3, patience=3)
+    watch = DegenerateWatch(problem, patience=3)
 
     def step(q_d):
-        return watch.eval([np.concatenate([q_d, np.zeros(5)]), 0.0, np.zeros(3), np.zeros(n_d + 5), np.zeros(3),
-                           np.zeros(0)])[0]
+        return int(watch.observe(q_d))
 
     planar, puma = planar_design(problem), np.array([j.value for j in problem.chain.design])
     assert [step(planar), step(planar), step(puma), step(planar), step(planar)] == [0, 0, 0, 0, 0]
@@ -106,8 +102,8 @@ def test_the_watch_stops_only_a_solve_that_stays_on_a_degenerate_design():
 def test_a_solve_stalled_on_a_planar_design_is_finished_with_its_twists_held(hold):
     # start 3 of the design-only problem on 12 waypoints walks into a planar arm (twists 0 and -pi) and, as is,
     # creeps there until the iteration cap (measured: 400 iterations, cost 0.42)
-    cfg, problem = design_only(hold=hold)
-    sol = solve_start(problem, transcription_for(cfg), multistart_from_config(cfg), 3)
+    cfg, problem = design_only()
+    sol = solve(problem, index=3, max_iter=400, hold_degenerate=hold)
     if not hold:
         assert sol.raw.status == "Maximum_Iterations_Exceeded"
         assert held_at_multiples_of_pi(problem, sol.raw.q_d) is not None  # it stalled on a degenerate design
@@ -116,13 +112,11 @@ def test_a_solve_stalled_on_a_planar_design_is_finished_with_its_twists_held(hol
     assert sol.raw.held.split() == [j.name for j in problem.chain.design if j.name.endswith(".alpha")]
     assert sol.raw.iterations < 400 and sol.metrics.tracks
     assert sol.metrics.design_cost < 0.5 * 0.4238
-    again = evaluate(problem, sol.raw.q_d, sol.raw.Q, sol.raw.V)  # a solution of the problem as posed
+    again = evaluate(problem, sol.raw.q_d, sol.raw.trajectory)  # a solution of the problem as posed
     assert again.tracks and np.isclose(again.design_cost, sol.metrics.design_cost, rtol=1e-12)
     assert all(j.lower <= v <= j.upper for j, v in zip(problem.chain.design, sol.raw.q_d, strict=True))
 
 
-def test_check_says_whether_stalled_solves_are_held():
-    from designopt.experiments.adapters import describe_search
-
-    assert "finished held" in describe_search(design_only(hold=True)[0])
-    assert "held" not in describe_search(design_only(hold=False)[0])
+def test_the_search_says_whether_stalled_solves_are_held():
+    assert "finished held" in Search(hold_degenerate=True).describe()
+    assert "held" not in Search(hold_degenerate=False).describe()

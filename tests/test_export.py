@@ -16,7 +16,8 @@ from designopt.export import export, urdf_model
 from designopt.initial_guess import initial_guesses
 from designopt.kinematics.chain import geometric_jacobian, placement_pose, tool_pose
 from designopt.problem import problem_from_config
-from designopt.solution import chain_from_file, solve_and_evaluate, to_dict
+from designopt.solution import chain_from_file, to_dict
+from designopt.solve import SolverProfile, solve_guess
 from designopt.transcriptions import Collocation
 
 pin = pytest.importorskip("pinocchio")
@@ -27,11 +28,10 @@ def solved():
     """A small solved design with both joint types, a twisted placement and a tool offset."""
     cfg = parse_config({"toolpath": {"kind": "circle", "radius": 0.08, "waypoints": 10},
                         "robot": {"structure": "RRPRRR", "dh": "generic"},
-                        "placement": {"xyz": [0.35, 0.1, -0.1], "ypr": [0.3, 0.0, 0.0]},
-                        "solver": {"max_iter": 300}})
+                        "placement": {"xyz": [0.35, 0.1, -0.1], "ypr": [0.3, 0.0, 0.0]}})
     problem = problem_from_config(cfg)
-    raw = Collocation(max_iter=300).build(problem).solve(initial_guesses(problem, 1, 0, 0.3, "ik")[0])
-    return to_dict(solve_and_evaluate(problem, "to", raw))
+    return to_dict(solve_guess(problem, Collocation(), SolverProfile(max_iter=300),
+                               initial_guesses(problem, 1, 0, 0.3, "ik")[0]))
 
 
 def _pin_model(path):

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import gantry_config
+from conftest import gantry_config, solve_from
 
 from designopt.config import parse_config
 from designopt.initial_guess import initial_guesses
 from designopt.problem import problem_from_config
-from designopt.solution import solve_and_evaluate
 from designopt.transcriptions import ForwardKinematics, transcription_named
 
 
@@ -17,8 +16,8 @@ from designopt.transcriptions import ForwardKinematics, transcription_named
 def test_fk_gantry_known_optimum(continuous):
     """Gantry with K = I: L_d = alpha^2 at every pose, so the design cost is alpha^2 N/(N-1) whatever FK picks."""
     problem = problem_from_config(parse_config(gantry_config()))
-    nlp = ForwardKinematics(continuous=continuous).build(problem)
-    sol = solve_and_evaluate(problem, nlp.scheme.name, nlp.solve(initial_guesses(problem, 1, 0, 0.3, "constant")[0]))
+    guess = initial_guesses(problem, 1, 0, 0.3, "constant")[0]
+    sol = solve_from(problem, guess, ForwardKinematics(continuous=continuous))
     N = problem.toolpath.n
     assert sol.raw.success
     assert sol.metrics.design_cost == pytest.approx(4.0 * N / (N - 1), rel=1e-9)
@@ -30,10 +29,9 @@ def test_fk_continuous_respects_the_velocity_bound():
     cfg = parse_config({"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 16},
                         "robot": {"joint_velocity": 4.0}, "placement": {"xyz": [0.45, 0.0, -0.2]}})
     problem = problem_from_config(cfg)
-    nlp = ForwardKinematics(continuous=True, max_iter=500).build(problem)
     guess = initial_guesses(problem, 1, 0, 0.3, "ik")[0]
-    raw = nlp.solve(guess)
-    sol = solve_and_evaluate(problem, "fk_continuous", raw)
+    sol = solve_from(problem, guess, ForwardKinematics(continuous=True), max_iter=500)
+    raw = sol.raw
     bound = 4.0 / (problem.toolpath.n - 1)
     assert sol.metrics.max_joint_step <= bound * (1 + 1e-6)
     step = np.abs(np.diff(raw.Q, axis=0)).max()
@@ -42,7 +40,7 @@ def test_fk_continuous_respects_the_velocity_bound():
 
 def test_transcription_names():
     assert transcription_named("fk").name == "fk"
-    assert transcription_named("fk_continuous", max_iter=5).name == "fk_continuous"
+    assert transcription_named("fk_continuous", hessian="auto").name == "fk_continuous"
     assert transcription_named("to").name == "to"
     with pytest.raises(ValueError):
         transcription_named("pso")

@@ -65,11 +65,12 @@ def test_components_follow_the_feed_frame_in_W():
 
 
 def test_config_milling_model_loads_only_cutting_waypoints():
+    """Every key of the config's force block reaches the process whose mean force loads the path (the mean
+    force itself is checked against closed forms above)."""
     cfg = parse_config({"toolpath": {"kind": "line", "waypoints": 5,
-                                     "force": {"model": "milling", "material": "aluminium", "kc11": 1000.0,
-                                               "mc": 0.0, "radial_ratio": 0.3, "axial_ratio": 0.2,
-                                               "tool_diameter": 0.01, "teeth": 3, "feed_per_tooth": 1e-4,
+                                     "force": {"material": "steel_c45", "teeth": 4, "feed_per_tooth": 1e-4,
                                                "axial_depth": 2e-3}}})
     tp = problem_from_config(cfg).toolpath
     assert tp.force_model == "milling"
-    np.testing.assert_allclose(tp.force_W, np.tile(mean_force(_process(LINEAR)), (5, 1)), rtol=1e-12)
+    process = MillingProcess(MATERIALS["steel_c45"], 0.010, 4, 1e-4, 2e-3)  # a full slot: any diameter
+    np.testing.assert_allclose(tp.force_W, np.tile(mean_force(process), (5, 1)), rtol=1e-12)

@@ -17,6 +17,7 @@ from designopt.evaluation import evaluate
 from designopt.gcode import parse_program, sample_program
 from designopt.initial_guess import initial_guess
 from designopt.problem import problem_from_config
+from designopt.transcriptions.trajectory import PiecewiseLinear
 
 MM = 1e-3
 # plane -> (first, second, normal) axis indices and the offset words along the first two
@@ -96,9 +97,9 @@ def _pocket_problem(tmp_path: Path, force=1.0):
     (tmp_path / "p.nc").write_text("G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F300\nG1 X20 F600\nG0 Z5\nG0 X40\nG1 Z0 F300\n"
                                    "G1 Y20 F600\n")
     cfg = parse_config({"toolpath": {"kind": "gcode", "file": "p.nc", "spacing": 0.004, "force": force},
-                        "robot": {"structure": "RRRRRR", "dh": "puma560", "design": []},
-                        "placement": {"optimize": False, "xyz": [0.45, 0.0, -0.2]}}, tmp_path / "c.yaml", tmp_path)
-    return problem_from_config(cfg, tmp_path)
+                        "robot": {"structure": "RRRRRR", "dh": "puma560"}, "design": [],
+                        "placement": {"xyz": [0.45, 0.0, -0.2]}}, tmp_path / "c.yaml", tmp_path)
+    return problem_from_config(cfg)
 
 
 def test_a_design_that_leaves_the_path_on_a_rapid_still_tracks(tmp_path):
@@ -108,13 +109,17 @@ def test_a_design_that_leaves_the_path_on_a_rapid_still_tracks(tmp_path):
     np.testing.assert_array_equal(np.linalg.norm(tp.force_W, axis=1)[~tp.is_tracked], 0.0)  # unloaded
     np.testing.assert_allclose(np.linalg.norm(tp.force_W, axis=1)[tp.is_tracked], 1.0)
     guess = initial_guess(problem, 0, 0, 0.0, "ik")
-    assert evaluate(problem, guess.q_d, guess.Q).tracks
+
+    def tracks(Q):
+        return evaluate(problem, guess.q_d, PiecewiseLinear(tp.t, Q)).tracks
+
+    assert tracks(guess.Q)
     away = guess.Q.copy()
     away[~tp.is_tracked] += 0.3  # leave the path (by ~0.1 m) wherever the tool is in a rapid
-    assert evaluate(problem, guess.q_d, away).tracks
+    assert tracks(away)
     cut = np.flatnonzero(tp.is_tracked)[3]
     away[cut] += 0.3
-    assert not evaluate(problem, guess.q_d, away).tracks
+    assert not tracks(away)
 
 
 BAD_PROGRAMS = [

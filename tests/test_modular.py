@@ -114,7 +114,7 @@ def test_modular_command_writes_every_stage(tmp_path):
     config = tmp_path / "m.yaml"
     config.write_text(yaml.safe_dump({"name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 10},
                                       "placement": {"xyz": [0.45, 0.0, -0.2]},
-                                      "solver": {"multistart": 1, "max_iter": 300}}))
+                                      "search": {"preset": "paper", "starts": 1}}))
     result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path / "r"), "--name", "t"])
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "modular" / "t"
@@ -127,6 +127,12 @@ def test_modular_command_writes_every_stage(tmp_path):
     # the search starts from the rounded assignment and never ends worse than its re-solve
     assert table.loc["neighbourhood", "design_cost"] <= table.loc["modular", "design_cost"] * (1 + 1e-9)
     assert (run / "figures" / "module_pca.png").stat().st_size > 1000
+    # the rounded assignment is the nearest modules of the continuous solution with L_mod (its file's links)
+    continuous = json.loads((run / "best-continuous_modular.json").read_text())
+    links = [(row["d"], row["a"], row["alpha"]) for row in continuous["dh"]]
+    nearest = [int(np.argmin([distance(np.array(link), m, CAT) for m in CAT.modules])) for link in links]
+    assert table.loc["rounded", "modules"] == " ".join(f"m{k + 1}" for k in nearest)
+    assert table.loc["modular", "modules"] == table.loc["rounded", "modules"]
     modular_file = summary.loc[summary["case"] == "modular", "solution_file"].iloc[0]
     final = json.loads((run / modular_file).read_text())
     modules = set(catalogue_from_config(parse_config({})).modules)
@@ -171,22 +177,17 @@ def test_tiny_enumeration_agrees_with_a_brute_force_loop(rng):
 
 
 def test_modular_study_end_to_end(tmp_path):
-    """The study through the CLI on a 2-link robot and a 2-module sub-catalogue: every one of the 2^2
+    """The study on a 2-link robot and a 2-module sub-catalogue: every one of the 2^2
     assignments is solved and ranked, rounding's pick is marked once, the weight study has its row."""
-    import yaml
-    from typer.testing import CliRunner
+    from designopt.experiments.modular import run_modular_study
+    from designopt.solve import SolverProfile, preset
 
-    from cli.main import app
-
-    config = tmp_path / "m.yaml"
-    config.write_text(yaml.safe_dump({
-        "name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 8},
-        "robot": {"structure": "RR", "dh": "generic"}, "placement": {"xyz": [0.3, 0.0, -0.2]},
-        "solver": {"multistart": 1, "max_iter": 100, "jobs": 1},
-        "modular": {"weight_study": [1.0e-3], "enumeration_modules": [1, 2], "enumeration_waypoints": 6}}))
-    result = CliRunner().invoke(app, ["modular-study", str(config), "--out", str(tmp_path / "r"), "--name", "a"])
-    assert result.exit_code == 0, result.output
-    run = tmp_path / "r" / "modular_study" / "a"
+    cfg = parse_config({"name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 8},
+                        "robot": {"structure": "RR", "dh": "generic"}, "placement": {"xyz": [0.3, 0.0, -0.2]}})
+    search = preset("paper", starts=1, profile=SolverProfile(max_iter=100))
+    result = run_modular_study(cfg, tmp_path / "r", "a", jobs=1, weights=(1.0e-3,), enumeration_modules=(1, 2),
+                               enumeration_waypoints=6, search=search)
+    run = result.directory.path
     enum = pd.read_csv(run / "enumeration.csv")
     assert sorted(enum["assignment"]) == ["m1 m1", "m1 m2", "m2 m1", "m2 m2"]
     assert enum["rounding_picked"].sum() == 1 and list(enum["rank"]) == [1, 2, 3, 4]

@@ -13,11 +13,11 @@ import pytest
 from test_objective_truth import SCARA_LAMBDA, scara_problem
 
 from designopt.costs import WaypointCost, sumsqr
-from designopt.experiments.tasks import multistart_tasks, solve_tasks
+from designopt.experiments.runs import Executor
 from designopt.initial_guess import initial_guess
-from designopt.multistart import Multistart
 from designopt.results_io import RunDirectory
-from designopt.solution import solve_and_evaluate
+from designopt.solve import Job, SolverProfile, preset, run_search, solve_guess
+from designopt.solve.local import prepared
 from designopt.transcriptions import Collocation
 from designopt.verify import verify_file
 
@@ -37,8 +37,8 @@ def problems(tmp_path):
 
 
 def solve(problem):
-    nlp = Collocation(max_iter=500, compile="none").build(problem)
-    return solve_and_evaluate(problem, "to", nlp.solve(initial_guess(problem, 1, 0, 0.3)))
+    return solve_guess(problem, Collocation(), SolverProfile(max_iter=500, compile="none"),
+                       initial_guess(problem, 1, 0, 0.3))
 
 
 def test_the_term_enters_the_objective_and_the_metrics(problems):
@@ -58,9 +58,9 @@ def test_the_term_enters_the_objective_and_the_metrics(problems):
 
 def test_structured_hessian_carries_the_term(problems, rng):
     _, extended = problems
-    ours = Collocation(hessian="structured", compile="none").build(extended)
-    ref = Collocation(hessian="auto").build(extended)
-    H_ours, H_ref = ours.solver.get_function("nlp_hess_l"), ref.solver.get_function("nlp_hess_l")
+    _, ours, _ = prepared(extended, Collocation(hessian="structured"), SolverProfile(compile="none"))
+    _, ref, _ = prepared(extended, Collocation(hessian="auto"), SolverProfile())
+    H_ours, H_ref, ours = ours.solver.get_function("nlp_hess_l"), ref.solver.get_function("nlp_hess_l"), ours.nlp
     for _ in range(3):
         x, lam_g = rng.normal(size=ours.n_variables), rng.normal(size=ours.n_constraints)
         np.testing.assert_allclose(np.triu(np.array(ca.DM(H_ours(x, [], 1.3, lam_g)))),
@@ -70,9 +70,9 @@ def test_structured_hessian_carries_the_term(problems, rng):
 def test_the_term_is_a_column_and_a_file_metric(problems, tmp_path):
     _, extended = problems
     run = RunDirectory(tmp_path / "run")
-    tasks = multistart_tasks("", "to", extended, Collocation(max_iter=500, compile="none"),
-                             Multistart(count=2, jobs=1))
-    done = solve_tasks(run, tasks, "custom", jobs=1)
+    search = preset("paper", starts=2, profile=SolverProfile(max_iter=500, compile="none"))
+    (searched,) = run_search([Job("", extended)], search, Executor(run, "custom", jobs=1))
+    done = searched.final
     summary = pd.read_csv(run.summary)
     assert "cost_joint_centring" in summary.columns and "cost_deformation" in summary.columns
     for (task, sol), (_, row) in zip(sorted(done, key=lambda d: d[1].raw.seed), summary.sort_values("seed").iterrows(),

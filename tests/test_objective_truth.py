@@ -23,9 +23,12 @@ from designopt.initial_guess import initial_guess
 from designopt.kinematics.joints import Role
 from designopt.kinematics.transforms import placement_transform
 from designopt.problem import problem_from_config
-from designopt.solution import solve_and_evaluate
+from designopt.solve import SolverProfile, solve_guess
 from designopt.transcriptions import Collocation
 from designopt.transcriptions.nlp import waypoint_terms
+from designopt.transcriptions.trajectory import PiecewiseLinear
+
+PROFILE = SolverProfile(max_iter=500, compile="none")
 
 # ---------------------------------------------------------------------------------------------------------
 # Independent reference implementations (plain numpy, written from the SPEC's formulas)
@@ -79,7 +82,7 @@ SCARA_K = (0.5, 5.0)  # revolute N*m/rad, prismatic N/m: not 1, and not equal
 SCARA_LAMBDA = 1.0e-3
 
 
-def scara_problem(tmp_path: Path, **costs):
+def scara_problem(tmp_path: Path, deformation_weight: float = 1.0, **weights):
     """RRP SCARA (all twists 0, tool axis vertical) milling a tilted ellipse: a curved path whose tangent has
     a vertical component, so both the revolute and the prismatic stiffness matter. Design joints: the second
     link length a2 and the workpiece position x, y (W is flipped, roll = pi, so its -z is the tool's +z)."""
@@ -88,16 +91,18 @@ def scara_problem(tmp_path: Path, **costs):
     (tmp_path / "ellipse.csv").write_text("x,y,z\n" + "".join(f"{a:.17g},{b:.17g},{c:.17g}\n" for a, b, c in pts))
     cfg = parse_config({
         "toolpath": {"kind": "csv", "file": "ellipse.csv", "waypoints": 20, "force": 1.5},
-        "robot": {"structure": "RRP", "design": ["a"], "dh": [{"a": SCARA_A1}, {"a": 0.3}, {}],
-                  "bounds": {"revolute": list(SCARA_LIMITS)},
+        # Only a2 is designed: a1 stays fixed, and a3 (which would only add to a2) too.
+        "design": ["link2.a", "x", "y"],
+        "robot": {"structure": "RRP", "dh": [{"a": SCARA_A1}, {"a": 0.3}, {}],
                   "stiffness": {"revolute": SCARA_K[0], "prismatic": SCARA_K[1]}, "joint_velocity": 50.0},
-        "placement": {"optimize": ["x", "y"], "xyz": [0.3, 0.3, 0.0], "ypr": [0.0, 0.0, math.pi]},
-        "costs": {"regularization": SCARA_LAMBDA, **costs},
+        "placement": {"xyz": [0.3, 0.3, 0.0], "ypr": [0.0, 0.0, math.pi]},
+        "costs": {"regularization": SCARA_LAMBDA, "deformation_weight": deformation_weight},
     }, "scara", tmp_path)
-    problem = problem_from_config(cfg, tmp_path)
-    # Only a2 is designed: a1 stays fixed, and a3 (which would only add to a2) too.
-    chain = problem.chain.with_roles({"link1.a": Role.FIXED, "link3.a": Role.FIXED})
-    return replace(problem, chain=chain)
+    problem = problem_from_config(cfg)
+    # the revolute joints' limits of the closed form (the prismatic joint keeps its default stroke)
+    joints = tuple(replace(j, lower=SCARA_LIMITS[0], upper=SCARA_LIMITS[1]) if j.role is Role.MOVING
+                   and j.kind == "angle" else j for j in problem.chain.joints)
+    return replace(problem, chain=replace(problem.chain, joints=joints), **weights)
 
 
 def scara_objective(points_W, force_W, a2, x, y):
@@ -145,8 +150,7 @@ def test_scara_optimum_matches_closed_form_grid(tmp_path):
     problem = scara_problem(tmp_path, smoothness=0.0, joint_regularization=0.0)
     assert [j.name for j in problem.chain.design] == ["placement.x", "placement.y", "link2.a"]
     tp = problem.toolpath
-    nlp = Collocation(max_iter=500, compile="none").build(problem)
-    sols = [solve_and_evaluate(problem, "to", nlp.solve(initial_guess(problem, i, 0, 0.3))) for i in range(3)]
+    sols = [solve_guess(problem, Collocation(), PROFILE, initial_guess(problem, i, 0, 0.3)) for i in range(3)]
     best = min((s for s in sols if s.metrics.tracks), key=lambda s: s.raw.objective)
     x, y, a2 = best.raw.q_d
 
@@ -184,8 +188,7 @@ def test_objective_equals_design_cost_plus_every_other_term(tmp_path, tracking):
     smooth, joint_reg, w_d, w_t = 1e-5, 1e-4, 3.0, 50.0
     problem = scara_problem(tmp_path, smoothness=smooth, joint_regularization=joint_reg, deformation_weight=w_d,
                             tracking_weight=w_t)
-    nlp = Collocation(tracking=tracking, max_iter=500, compile="none").build(problem)
-    sol = solve_and_evaluate(problem, "to", nlp.solve(initial_guess(problem, 1, 0, 0.3)))
+    sol = solve_guess(problem, Collocation(tracking=tracking), PROFILE, initial_guess(problem, 1, 0, 0.3))
     assert sol.raw.success, sol.raw.status
     Q, V, q_d, h = sol.raw.Q, sol.raw.V, sol.raw.q_d, problem.toolpath.dt
     m = sol.metrics
@@ -242,7 +245,7 @@ def test_optimizer_and_evaluation_agree_with_reference_at_random_points(deflecti
         # The evaluation (the reported numbers) at a one-waypoint path through the same point.
         tp = toolpaths.Toolpath("point", np.array([0.0, 1.0]), np.tile(s_W, (2, 1)), np.zeros((2, 3)),
                                 np.tile(f_W, (2, 1)))
-        m = evaluate(replace(problem, toolpath=tp), q_d, np.tile(q, (2, 1)))
+        m = evaluate(replace(problem, toolpath=tp), q_d, PiecewiseLinear(tp.t, np.tile(q, (2, 1))))
         assert m.deformation[0] == pytest.approx(L_ref, rel=1e-10)
         assert m.position_error[0] == pytest.approx(np.linalg.norm(p_ref - s_W), rel=1e-9, abs=1e-12)
         assert m.axis_error[0] == pytest.approx(np.linalg.norm(z_ref - [0, 0, -1]), rel=1e-9, abs=1e-12)

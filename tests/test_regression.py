@@ -9,10 +9,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import solve
 
 from designopt.config import load_config
-from designopt.experiments.adapters import multistart_from_config, transcription_for
-from designopt.multistart import solve_start
 from designopt.problem import problem_from_config
 from designopt.solution import to_dict
 
@@ -22,8 +21,8 @@ ROOT = Path(__file__).resolve().parent.parent
 def test_default_job_reproduces_the_stored_solution():
     before = json.loads((ROOT / "tests" / "data" / "milling_seed0_before_refactor.json").read_text())
     cfg = load_config(ROOT / "configs" / "milling.yaml")
-    problem = problem_from_config(cfg, ROOT / "configs")
-    sol = solve_start(problem, transcription_for(cfg), multistart_from_config(cfg), 0)
+    problem = problem_from_config(cfg)
+    sol = solve(problem)
     now = to_dict(sol)
     assert now["metrics"]["status"] == before["metrics"]["status"] == "Solve_Succeeded"
     assert now["metrics"]["design_cost"] == pytest.approx(before["metrics"]["design_cost"], rel=1e-6)

@@ -20,13 +20,13 @@ from cli.main import app
 from designopt.verify import verify_file
 
 ROOT = Path(__file__).resolve().parent.parent
-KEY = ["case", "method", "structure", "seed"]
+KEY = ["case", "stage", "method", "structure", "seed"]
 runner = CliRunner()
 
 SMALL = {
     "toolpath": {"kind": "figure_eight", "width": 0.6, "height": 0.3, "waypoints": 12},
     "placement": {"xyz": [0.45, 0.0, -0.2]},
-    "solver": {"multistart": 3, "max_iter": 300, "jobs": 1},
+    "search": {"preset": "paper", "starts": 3},
 }
 
 
@@ -36,12 +36,13 @@ def shared_cache(tmp_path_factory):
 
 
 def read_summary(path: Path) -> pd.DataFrame:
-    return pd.read_csv(path, dtype={"case": str}, keep_default_na=False, na_values={"case": []})
+    return pd.read_csv(path, dtype={"case": str, "stage": str}, keep_default_na=False,
+                       na_values={"case": [], "stage": []})
 
 
 def kill_part_way(args: list[str], summary: Path, timeout: float = 240) -> pd.DataFrame:
     """Start `designopt ARGS` in a subprocess, SIGKILL it once its first solve is written, return the rows."""
-    proc = subprocess.Popen([sys.executable, "-m", "cli.main", *args], cwd=ROOT, start_new_session=True,
+    proc = subprocess.Popen([sys.executable, "-m", "cli.main", *args, "--jobs", "1"], cwd=ROOT, start_new_session=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.time() + timeout
     while time.time() < deadline and proc.poll() is None:
@@ -86,8 +87,7 @@ def _lose_first_file(run: Path, before: pd.DataFrame) -> None:
 
 
 def test_run_resumes(tmp_path):
-    search = {"explore_starts": 5, "explore_waypoints": 6, "refine": 2}
-    config = _setup(tmp_path, {"name": "job", "solver": {**SMALL["solver"], "search": search}})
+    config = _setup(tmp_path, {"name": "job", "search": {"preset": "quick", "starts": 5}})
     out, run = tmp_path / "r", tmp_path / "r" / "job" / "k"
     before = kill_part_way(["run", str(config), "--out", str(out), "--name", "k", "--no-figures"], run / "summary.csv")
     assert len(before) < 5, "the run was not killed part-way"
@@ -95,49 +95,73 @@ def test_run_resumes(tmp_path):
     again = runner.invoke(app, ["run", str(config), "--out", str(out), "--name", "k"])
     assert again.exit_code == 2 and "--resume" in again.output  # never overwrites a run silently
     result = runner.invoke(app, ["run", str(config), "--out", str(out), "--name", "k", "--resume", "--no-figures"])
-    refined = {k for k in read_summary(run / "summary.csv")[KEY].itertuples(index=False, name=None) if k[0] == "refine"}
+    refined = {k for k in read_summary(run / "summary.csv")[KEY].itertuples(index=False, name=None) if k[1] == "refine"}
     assert 1 <= len(refined) <= 2  # the best two distinct coarse optima, refined on the full path
-    after = check_resumed(run, before, {("explore", "to", "RRRRRR", s) for s in range(5)} | refined, result)
+    after = check_resumed(run, before, {("", "explore", "to", "RRRRRR", s) for s in range(5)} | refined, result)
     assert after["best"].sum() == 1 and (run / "best.json").is_file()
 
 
 def test_continuous_resumes(tmp_path):
-    config = _setup(tmp_path, {"continuous": {"cases": ["placement_only", "combined"], "methods": ["to", "fk"]}})
+    config = _setup(tmp_path)
     out, run = tmp_path / "r", tmp_path / "r" / "continuous" / "k"
-    before = kill_part_way(["continuous", str(config), "--out", str(out), "--name", "k"], run / "summary.csv")
+    subset = ["--cases", "placement_only,combined", "--methods", "to,fk"]
+    before = kill_part_way(["continuous", str(config), "--out", str(out), "--name", "k", *subset], run / "summary.csv")
     assert len(before) < 12, "the run was not killed part-way"
     _lose_first_file(run, before)
-    result = runner.invoke(app, ["continuous", str(config), "--out", str(out), "--name", "k", "--resume"])
-    expected = {(c, m, "RRRRRR", s) for c in ("placement_only", "combined") for m in ("to", "fk") for s in range(3)}
+    result = runner.invoke(app, ["continuous", str(config), "--out", str(out), "--name", "k", "--resume", *subset])
+    expected = {(c, "start", m, "RRRRRR", s) for c in ("placement_only", "combined") for m in ("to", "fk")
+                for s in range(3)}
     check_resumed(run, before, expected, result)
     assert len(pd.read_csv(run / "table.csv")) == 4
 
 
 def test_waypoints_resumes(tmp_path):
-    config = _setup(tmp_path, {"continuous": {"waypoint_study": [8, 10, 12]}})
+    config = _setup(tmp_path)
     out, run = tmp_path / "r", tmp_path / "r" / "waypoints" / "k"
-    before = kill_part_way(["waypoints", str(config), "--out", str(out), "--name", "k"], run / "summary.csv")
+    counts = ["--waypoints", "8,10,12"]
+    before = kill_part_way(["waypoints", str(config), "--out", str(out), "--name", "k", *counts], run / "summary.csv")
     assert len(before) < 9, "the run was not killed part-way"
     _lose_first_file(run, before)
-    result = runner.invoke(app, ["waypoints", str(config), "--out", str(out), "--name", "k", "--resume"])
-    check_resumed(run, before, {(f"N{n}", "to", "RRRRRR", s) for n in (8, 10, 12) for s in range(3)}, result)
+    result = runner.invoke(app, ["waypoints", str(config), "--out", str(out), "--name", "k", "--resume", *counts])
+    check_resumed(run, before, {(f"N{n}", "start", "to", "RRRRRR", s) for n in (8, 10, 12) for s in range(3)},
+                  result)
     table = pd.read_csv(run / "table.csv")
     assert list(table["waypoints"]) == [8, 10, 12] and table["max_midpoint_error"].notna().all()
 
 
 def test_modular_resumes(tmp_path):
-    config = _setup(tmp_path, {"solver": {**SMALL["solver"], "multistart": 2}})
+    config = _setup(tmp_path, {"search": {"preset": "paper", "starts": 2}})
     out, run = tmp_path / "r", tmp_path / "r" / "modular" / "k"
     before = kill_part_way(["modular", str(config), "--out", str(out), "--name", "k"], run / "summary.csv")
     assert len(before) < 9, "the run was not killed part-way"
     _lose_first_file(run, before)
     result = runner.invoke(app, ["modular", str(config), "--out", str(out), "--name", "k", "--resume"])
     after = read_summary(run / "summary.csv")
-    solves = {(c, m, "RRRRRR", s) for c, m in (("continuous", "to"), ("fk", "fk"), ("continuous_modular", "to"),
-                                                ("modular", "to")) for s in range(2)}
+    solves = {(c, "start", m, "RRRRRR", s) for c, m in (("continuous", "to"), ("fk", "fk"),
+                                                         ("continuous_modular", "to"), ("modular", "to"))
+              for s in range(2)}
     rounded = {k for k in after[KEY].itertuples(index=False, name=None) if k[0] == "rounded"}
     assert len(rounded) == 1
     searched = {k for k in after[KEY].itertuples(index=False, name=None) if k[0].startswith("nb-")}
     assert len(searched) % 2 == 0 and len(searched) <= 2 * 48  # each assignment tried: 2 starts
     check_resumed(run, before, solves | rounded | searched, result)
     assert len(pd.read_csv(run / "table.csv")) == 6
+
+
+def test_a_row_without_its_solution_file_is_dropped_on_resume(tmp_path):
+    """RunDirectory.resume keeps a row only with its file: the row of a lost file leaves summary.csv (so the solve
+    is done again and counted once), and a second row for the same solve is dropped too."""
+    from designopt.results_io import RunDirectory
+
+    run = RunDirectory(tmp_path / "run")
+    rows = [{"experiment": "e", "case": "c", "stage": "start", "method": "to", "structure": "RR", "seed": s,
+             "design_cost": float(s), "solution_file": f"solutions/s{s}.json"} for s in range(3)]
+    for row in [*rows, {**rows[2], "design_cost": 9.0}]:
+        run.append_row(row)
+    for s in (0, 2):
+        (run.path / f"solutions/s{s}.json").write_text("{}")
+    kept = run.resume()
+    assert set(kept) == {("c", "start", "to", "RR", 0), ("c", "start", "to", "RR", 2)}
+    assert float(kept["c", "start", "to", "RR", 2]["design_cost"]) == 2.0  # the first row of a solve counts
+    after = read_summary(run.summary)
+    assert sorted(after["seed"]) == [0, 2]

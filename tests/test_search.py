@@ -1,4 +1,4 @@
-"""The search (designopt.search): the coarse path is a subset of the task, a solution lifted to another sampling
+"""The search (designopt.solve): the coarse path is a subset of the task, a solution lifted to another sampling
 keeps its trajectory, distinct optima are told apart, and on a problem with a known optimum that a single start
 misses, the search finds it."""
 
@@ -10,25 +10,38 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from conftest import solve
 
 from designopt.config import parse_config
-from designopt.experiments.adapters import multistart_from_config, search_from_config, transcription_for
-from designopt.experiments.run import run_experiment
-from designopt.multistart import solve_start
+from designopt.experiments.adapters import search_from_config
 from designopt.problem import problem_from_config
-from designopt.search import Search, coarse_problem, distinct_best, lifted_guess
 from designopt.solution import solve_and_evaluate
+from designopt.solve import (
+    PRESETS,
+    Job,
+    Search,
+    SolverProfile,
+    distinct_best,
+    lifted_guess,
+    preset,
+    run_search,
+    run_task,
+)
+from designopt.solve.strategies.coarse_to_fine import coarse_problem
 from designopt.toolpaths import figure_eight, subsample
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def test_the_config_and_the_library_share_the_search_defaults():
-    # The defaults are written twice (pydantic validates the config, the library runs without one): a user who
-    # leaves `solver.search` out must get what `Search()` documents.
-    assert search_from_config(parse_config({})) == Search()
-    changed = search_from_config(parse_config({"solver": {"search": {"screen": 5, "strategy": "multistart"}}}))
-    assert (changed.screen, changed.strategy) == (5, "multistart")
+def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
+    # a config without `search` gets the library's default search; its three keys each change what runs
+    assert search_from_config(parse_config({})) == PRESETS["default"] == Search()
+    for name in PRESETS:
+        assert search_from_config(parse_config({"search": {"preset": name}})) == PRESETS[name]
+    changed = search_from_config(parse_config({"search": {"preset": "paper", "seed": 7, "starts": 3}}))
+    assert (changed.strategy, changed.seed, changed.starts) == ("multistart", 7, 3)
+    assert changed.profile == PRESETS["paper"].profile
+    assert preset("quick", seed=2) == Search(starts=40, refine=2, seed=2, profile=PRESETS["quick"].profile)
 
 
 def test_a_coarse_path_is_a_subset_of_the_task():
@@ -50,10 +63,11 @@ def test_the_velocity_of_a_sampled_trajectory_is_its_derivative(gantry_problem):
     rng = np.random.default_rng(3)
     from designopt.solution import Solution
     from designopt.transcriptions.base import RawResult
+    from designopt.transcriptions.trajectory import HermiteCubic
 
     n, m = gantry_problem.toolpath.n, gantry_problem.chain.n_moving
-    raw = RawResult(np.zeros(gantry_problem.chain.n_design), rng.normal(size=(n, m)), rng.normal(size=(n, m)), "x",
-                    True, 0, 0.0, 0.0, 0.0, 0, 0)
+    trajectory = HermiteCubic(gantry_problem.toolpath.t, rng.normal(size=(n, m)), rng.normal(size=(n, m)))
+    raw = RawResult(np.zeros(gantry_problem.chain.n_design), trajectory, "x", True, 0, 0.0, 0.0, 0.0, 0, 0)
     sol = Solution(gantry_problem, "to", raw, None)
     t = rng.uniform(0.01, 0.99, 40)
     eps = 1e-6
@@ -67,7 +81,6 @@ def test_the_velocity_of_a_sampled_trajectory_is_its_derivative(gantry_problem):
 def milling_12():
     cfg = yaml.safe_load((ROOT / "configs" / "milling.yaml").read_text())
     cfg["toolpath"]["waypoints"] = 12
-    cfg["solver"] = {"max_iter": 300, "jobs": 1}
     return cfg
 
 
@@ -77,7 +90,7 @@ def test_a_lifted_solution_starts_where_it_ended(milling_12):
     cfg = parse_config(milling_12)
     full = problem_from_config(cfg)
     coarse = coarse_problem(full, 6)
-    sol = solve_start(coarse, transcription_for(cfg), multistart_from_config(cfg), 0)
+    sol = solve(coarse, max_iter=300)
     guess = lifted_guess(full, sol)
     shared = np.flatnonzero(np.isin(full.toolpath.t, coarse.toolpath.t))
     assert len(shared) == coarse.toolpath.n
@@ -89,7 +102,7 @@ def test_a_lifted_solution_starts_where_it_ended(milling_12):
 def test_distinct_best_takes_one_solution_per_optimum(milling_12):
     cfg = parse_config(milling_12)
     problem = problem_from_config(cfg)
-    sol = solve_start(problem, transcription_for(cfg), multistart_from_config(cfg), 0)
+    sol = solve(problem, max_iter=300)
     from dataclasses import replace
 
     def moved(cost, shift):
@@ -104,48 +117,54 @@ def test_distinct_best_takes_one_solution_per_optimum(milling_12):
     assert distinct_best(sols, 10, tol=2.0) == [3]
 
 
-def test_the_search_finds_the_optimum_a_single_start_misses(milling_12, tmp_path):
+def test_the_search_finds_the_optimum_a_single_start_misses(milling_12):
     """The PUMA-560 placed by its yaw alone: the optimum over yaw is known by an exhaustive grid (24 yaws, the
     workpiece fixed, 2 starts each); start 0 (the configured yaw) ends in a local optimum 28 % above it, the
     search (8 coarse starts, the best 2 refined) reaches it."""
-    def config(**placement):
+    def config(design, **placement):
         c = copy.deepcopy(milling_12)
-        c["robot"]["design"] = []
+        c["design"] = design
         c["placement"].update(placement)
         return parse_config(c)
 
     grid = []
     for yaw in np.linspace(-np.pi, np.pi, 25)[:-1]:
-        cfg = config(optimize=False, ypr=[float(yaw), 0.0, 0.0])
-        p, t, s = problem_from_config(cfg), transcription_for(cfg), multistart_from_config(cfg)
-        grid += [x.metrics.design_cost for x in (solve_start(p, t, s, i) for i in range(2)) if x.metrics.tracks]
+        p = problem_from_config(config([], ypr=[float(yaw), 0.0, 0.0]))
+        grid += [x.metrics.design_cost for x in (solve(p, index=i, max_iter=300) for i in range(2)) if x.metrics.tracks]
     known = min(grid)
 
-    cfg = config(optimize=["yaw"])
-    single = solve_start(problem_from_config(cfg), transcription_for(cfg), multistart_from_config(cfg), 0)
+    problem = problem_from_config(config(["yaw"]))
+    single = solve(problem, max_iter=300)
     assert single.metrics.design_cost > 1.2 * known  # one start misses it
 
-    cfg = cfg.model_copy(update={"solver": cfg.solver.model_copy(update={"search": cfg.solver.search.model_copy(
-        update={"explore_starts": 8, "explore_waypoints": 6, "refine": 2})})})
-    result = run_experiment(cfg, ROOT / "configs", tmp_path, "s", figures=False)
-    assert result.best is not None and result.best.metrics.tracks
-    assert result.best.metrics.design_cost <= known * 1.001  # at least as good as the grid's best
-    assert len(result.explored) == 8 and 1 <= len(result.solutions) <= 2
+    search = Search(starts=8, explore_waypoints=6, refine=2, profile=SolverProfile(max_iter=300))
+    (searched,) = run_search([Job("", problem)], search, lambda tasks: [(t, run_task(t)) for t in tasks])
+    best = searched.best[1]
+    assert best is not None and best.metrics.tracks
+    assert best.metrics.design_cost <= known * 1.001  # at least as good as the grid's best
+    assert len(searched.explore) == 8 and 1 <= len(searched.final) <= 2
 
 
-def test_each_stage_keeps_its_own_iteration_cap(milling_12, tmp_path):
-    """Exploration within explore_max_iter, screening within screen_max_iter, refinement within solver.max_iter:
-    a screening solve only ranks, so a stalling one must not take the full budget (design only stalls there)."""
-    import pandas as pd
+def test_each_stage_keeps_its_own_iteration_cap(milling_12):
+    """Exploration within explore_max_iter, screening within screen_max_iter, refinement within the profile's
+    max_iter: a screening solve only ranks, so a stalling one must not take the full budget (design only stalls
+    there)."""
+    problem = problem_from_config(parse_config(milling_12))
+    search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, screen_waypoints=9, screen=3,
+                    screen_max_iter=25, refine=1, profile=SolverProfile(max_iter=300))
+    done = []
 
-    cfg = copy.deepcopy(milling_12)
-    cfg["solver"]["search"] = {"explore_starts": 4, "explore_waypoints": 6, "explore_max_iter": 100,
-                               "screen_waypoints": 9, "screen": 3, "screen_max_iter": 25, "refine": 1}
-    result = run_experiment(parse_config(cfg), ROOT / "configs", tmp_path, "s", figures=False)
-    rows = pd.read_csv(result.directory.path / "summary.csv")
+    def execute(tasks):
+        done.extend((t, run_task(t)) for t in tasks)
+        return done[-len(tasks):]
+
+    run_search([Job("", problem)], search, execute)
     caps = {"explore": 100, "screen": 25, "refine": 300}
-    assert set(rows.case) == set(caps)
+    assert {t.stage for t, _ in done} == set(caps)
     for stage, cap in caps.items():
-        assert rows[rows.case == stage].iterations.max() <= cap
-    assert rows[rows.case == "screen"].iterations.max() == 25  # 25 iterations do not converge on a finer path
-    assert rows[rows.case == "refine"].iterations.max() > 25
+        assert all(t.profile.max_iter == cap for t, _ in done if t.stage == stage)
+        assert max(s.raw.iterations for t, s in done if t.stage == stage) <= cap
+    waypoints = {t.stage: t.problem.toolpath.n for t, _ in done}
+    assert waypoints == {"explore": 6, "screen": 9, "refine": 12}
+    assert max(s.raw.iterations for t, s in done if t.stage == "screen") == 25  # 25 do not converge on 9 waypoints
+    assert max(s.raw.iterations for t, s in done if t.stage == "refine") > 25

@@ -17,7 +17,10 @@ import yaml
 from typer.testing import CliRunner
 
 from cli.main import app
-from designopt.experiments.sweep import enumerate_structures, neighbours
+from designopt.config import load_config
+from designopt.experiments.sweep import enumerate_structures, run_sweep
+from designopt.solve import Search, SolverProfile
+from designopt.solve.strategies.neighbours import neighbours
 from designopt.verify import verify_file
 
 runner = CliRunner()
@@ -45,9 +48,8 @@ def test_a_neighbours_design_starts_the_joints_of_the_same_name():
     from designopt.initial_guess import design_from
     from designopt.problem import problem_from_config
 
-    base = {"robot": {"dh": "generic", "design": ["d", "a", "alpha"]}}
-    rr = problem_from_config(parse_config({**base, "robot": {**base["robot"], "structure": "RRRRRR"}}))
-    pr = problem_from_config(parse_config({**base, "robot": {**base["robot"], "structure": "PRRRRR"}}))
+    rr = problem_from_config(parse_config({"robot": {"dh": "generic", "structure": "RRRRRR"}}))
+    pr = problem_from_config(parse_config({"robot": {"dh": "generic", "structure": "PRRRRR"}}))
     q = np.linspace(0.1, 0.9, rr.chain.n_design)
     mapped = design_from(pr, rr, q)
     given = dict(zip([j.name for j in rr.chain.design], q, strict=True))
@@ -56,14 +58,14 @@ def test_a_neighbours_design_starts_the_joints_of_the_same_name():
     assert "link1.theta" in {j.name for j in pr.chain.design} and "link1.d" not in {j.name for j in pr.chain.design}
 
 
-def small_config(tmp_path, **solver) -> Path:
+def small_config(tmp_path) -> Path:
+    """A short line; the quick search with 3 starts (on a path this short the exploration uses every waypoint)."""
     path = tmp_path / "sweep.yaml"
     path.write_text(yaml.safe_dump({
         "name": "structures",
         "toolpath": {"kind": "line", "length": 0.2, "waypoints": 8},
         "placement": {"xyz": [0.3, 0.0, -0.2]},
-        "solver": {"max_iter": 200, "search": {"explore_starts": 3, "explore_waypoints": 5, "refine": 1},
-                   **solver},
+        "search": {"preset": "quick", "starts": 3},
     }))
     return path
 
@@ -83,14 +85,15 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
     run = tmp_path / "r" / "structures" / "a"
     summary = pd.read_csv(run / "summary.csv")
     assert set(summary["structure"]) == {"R", "P", "RR", "RP", "PR", "PP"}
-    stages = summary.groupby(["structure", "case"]).size()
-    for s in ("RR", "RP", "PR", "PP"):  # every structure gets the same search: 3 coarse starts, the best refined
-        assert stages[s, "sweep-explore"] == 3 and stages.get((s, "sweep-refine"), 0) <= 1
+    assert (summary["case"] == "sweep").all()
+    stages = summary.groupby(["structure", "stage"]).size()
+    for s in ("RR", "RP", "PR", "PP"):  # every structure gets the same search: 3 coarse starts, the best 2 refined
+        assert stages[s, "explore"] == 3 and stages.get((s, "refine"), 0) <= 2
     # a structure gets a neighbour-seeded start exactly when a neighbour (one joint type changed) searched its
     # way to a cheaper design than its own
-    refined = summary[summary["case"] == "sweep-refine"]
+    refined = summary[summary["stage"] == "refine"]
     best = refined[refined["tracks"]].groupby("structure")["design_cost"].min()
-    seeded = set(summary.loc[summary["case"] == "sweep-neighbour", "structure"])
+    seeded = set(summary.loc[summary["stage"] == "neighbour", "structure"])
     for s in best.index:
         better = [n for n in neighbours(s, list(best.index)) if best[n] < best[s]]
         assert (s in seeded) == bool(better), s
@@ -100,6 +103,7 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
     assert (table["explore_starts"] == 3).all()
     refined = table[table["starts"] == 1]
     assert (refined["near_best"] == refined["tracking_starts"]).all()  # one full-path solve: it is its own best
+    assert (table["near_best"] <= table["tracking_starts"]).all()
     for f in (run / "solutions").glob("*.json"):
         assert verify_file(f) == [], f
     assert (run / "figures" / "structures_best_per_dof.png").is_file()
@@ -111,19 +115,19 @@ def test_failed_solves_are_rows(tmp_path, capfd):
     # 1 revolute joint cannot meet 5 tracking equalities per waypoint (IPOPT: Not_Enough_Degrees_Of_Freedom);
     # 2 joints stopped after 2 iterations do not converge (Maximum_Iterations_Exceeded, or a failed
     # restoration). All are rows.
-    result = sweep(small_config(tmp_path, max_iter=2, search={"explore_starts": 3, "explore_waypoints": 5,
-                                                                "explore_max_iter": 2}),
-                   tmp_path / "r", "--max-dof", "2", "--jobs", "1")
-    assert result.exit_code == 0, result.output
+    cfg = load_config(small_config(tmp_path))
+    search = Search(starts=3, explore_waypoints=5, explore_max_iter=2, profile=SolverProfile(max_iter=2))
+    result = run_sweep(cfg, tmp_path / "r", "sweep", 1, 2, jobs=1, search=search)
     summary = pd.read_csv(tmp_path / "r" / "structures" / "sweep" / "summary.csv")
-    assert len(summary) == 6 * 3 and (summary["case"] == "sweep-explore").all()  # nothing tracks: nothing refined
+    assert len(summary) == 6 * 3 and (summary["stage"] == "explore").all()  # nothing tracks: nothing refined
     assert not summary["success"].any() and not summary["tracks"].any()
     statuses = summary.groupby("structure")["status"].agg(set)
     assert statuses["R"] == {"Not_Enough_Degrees_Of_Freedom"}
     assert "Maximum_Iterations_Exceeded" in statuses["RR"]
-    assert "0 track the path" in result.output
+    assert result.table["design_cost"].isna().all()
     # decided without calling IPOPT: CasADi would print a warning per over-constrained solve on the terminal
-    assert "overconstrained" not in result.output + capfd.readouterr().err
+    captured = capfd.readouterr()
+    assert "overconstrained" not in captured.out + captured.err
 
 
 def _digest(path: Path) -> str:
@@ -154,8 +158,8 @@ def test_killed_sweep_resumes_without_losing_or_repeating(tmp_path):
     assert result.exit_code == 0, result.output
     after = pd.read_csv(summary)
     assert set(after["structure"]) == set(enumerate_structures(1, 3))
-    assert not after.duplicated(["case", "structure", "seed"]).any()  # each solve exactly once
-    explored = after[after["case"] == "sweep-explore"].groupby("structure").size()
+    assert not after.duplicated(["case", "stage", "structure", "seed"]).any()  # each solve exactly once
+    explored = after[after["stage"] == "explore"].groupby("structure").size()
     assert (explored == 3).all()
     assert summary.read_bytes().startswith(prefix)  # finished rows untouched, byte for byte
     for f, digest in kept.items():
@@ -168,8 +172,8 @@ def test_dask_local_cluster_gives_the_same_rows_as_loky(tmp_path):
     a = sweep(config, tmp_path / "r", "--max-dof", "1", "--name", "loky", "--jobs", "2")
     b = sweep(config, tmp_path / "r", "--max-dof", "1", "--name", "dask", "--backend", "dask", "--jobs", "2")
     assert a.exit_code == 0 and b.exit_code == 0, (a.output, b.output)
-    cols = ["structure", "case", "seed", "status", "iterations", "design_cost", "tracks"]
-    order = ["structure", "case", "seed"]
+    cols = ["structure", "stage", "seed", "status", "iterations", "design_cost", "tracks"]
+    order = ["structure", "stage", "seed"]
     loky = pd.read_csv(tmp_path / "r" / "structures" / "loky" / "summary.csv")[cols].sort_values(order)
     dask = pd.read_csv(tmp_path / "r" / "structures" / "dask" / "summary.csv")[cols].sort_values(order)
     pd.testing.assert_frame_equal(loky.reset_index(drop=True), dask.reset_index(drop=True), rtol=1e-9)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from designopt.search import cluster_designs, design_distance
+from designopt.solve import cluster_designs, design_distance
 from designopt.tables import best_so_far
 
 

@@ -7,12 +7,14 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 import pytest
-from conftest import gantry_config
+from conftest import gantry_config, solve_from
 
 from designopt.config import parse_config
 from designopt.initial_guess import initial_guesses
 from designopt.problem import problem_from_config
-from designopt.solution import Solution, solve_and_evaluate, to_dict
+from designopt.solution import Solution, to_dict
+from designopt.solve import SolverProfile
+from designopt.solve.local import prepared
 from designopt.transcriptions import TRANSCRIPTIONS, transcription_named
 
 METHODS = sorted(TRANSCRIPTIONS)
@@ -23,8 +25,8 @@ def test_known_optimum(method):
     """A Cartesian gantry with K = I: C w = (F, 0) at every pose, so L_d = alpha^2 and the design cost is
     alpha^2 N / (N - 1) whatever the design (alpha = 2 here)."""
     problem = problem_from_config(parse_config(gantry_config()))
-    nlp = transcription_named(method, max_iter=300).build(problem)
-    sol = solve_and_evaluate(problem, method, nlp.solve(initial_guesses(problem, 1, 0, 0.3, "constant")[0]))
+    guess = initial_guesses(problem, 1, 0, 0.3, "constant")[0]
+    sol = solve_from(problem, guess, transcription_named(method), max_iter=300)
     N = problem.toolpath.n
     assert sol.raw.success, sol.raw.status
     assert sol.metrics.tracks
@@ -33,9 +35,9 @@ def test_known_optimum(method):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_a_failed_solve_is_a_result(method, gantry_problem):
-    nlp = transcription_named(method, max_iter=1).build(gantry_problem)
-    raw = nlp.solve(initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0])
-    sol = solve_and_evaluate(gantry_problem, method, raw)
+    sol = solve_from(gantry_problem, initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0],
+                     transcription_named(method), max_iter=1)
+    raw = sol.raw
     assert not raw.success and raw.status == "Maximum_Iterations_Exceeded"
     assert sol.row()["status"] == "Maximum_Iterations_Exceeded" and sol.row()["iterations"] == 1
 
@@ -46,10 +48,11 @@ def test_structured_hessian_equals_casadi(method, rng):
            "robot": {"structure": "RPRR", "dh": "generic", "stiffness": {"revolute": 2.0, "prismatic": 0.5}},
            "placement": {"xyz": [0.4, 0.1, 0.0], "keep_out_radius": 0.1}}
     problem = problem_from_config(parse_config(cfg))
-    ours = transcription_named(method, hessian="structured", compile="none").build(problem)
-    ref = transcription_named(method, hessian="auto").build(problem)
+    _, ours, _ = prepared(problem, transcription_named(method, hessian="structured"), SolverProfile(compile="none"))
+    _, ref, _ = prepared(problem, transcription_named(method, hessian="auto"), SolverProfile())
+    ours, ref, H_ours, H_ref = (ours.nlp, ref.nlp, ours.solver.get_function("nlp_hess_l"),
+                                ref.solver.get_function("nlp_hess_l"))
     assert (ours.n_variables, ours.n_constraints) == (ref.n_variables, ref.n_constraints)
-    H_ours, H_ref = ours.nlp.solver.get_function("nlp_hess_l"), ref.nlp.solver.get_function("nlp_hess_l")
     for _ in range(3):
         x, lam_g = rng.normal(size=ours.n_variables), rng.normal(size=ours.n_constraints)
         np.testing.assert_allclose(np.triu(np.array(ca.DM(H_ours(x, [], 0.7, lam_g)))),
@@ -63,8 +66,7 @@ def solved():
                                                                                        "prismatic": 0.5}},
                         "placement": {"xyz": [0.35, 0.1, -0.1], "ypr": [0.3, 0.0, 0.0]}})
     problem = problem_from_config(cfg)
-    raw = transcription_named("to", max_iter=300).build(problem).solve(initial_guesses(problem, 1, 0, 0.3)[0])
-    return solve_and_evaluate(problem, "to", raw)
+    return solve_from(problem, initial_guesses(problem, 1, 0, 0.3)[0], max_iter=300)
 
 
 def test_solution_round_trips_through_its_file(solved):
@@ -73,9 +75,44 @@ def test_solution_round_trips_through_its_file(solved):
     assert back.metrics.design_cost == pytest.approx(solved.metrics.design_cost, rel=1e-12)
     assert back.metrics.max_position_error == pytest.approx(solved.metrics.max_position_error, abs=1e-15)
     again = to_dict(back)
-    for key in ("structure", "dh", "tool", "placement", "stiffness", "q", "v", "joint_limits"):
+    for key in ("structure", "dh", "tool", "placement", "stiffness", "q", "v", "trajectory", "joint_limits"):
         assert again[key] == data[key], key
     np.testing.assert_allclose(again["toolpath"]["force_W"], data["toolpath"]["force_W"], atol=1e-15)
+
+
+def test_a_file_reads_back_with_its_own_cost_weights(solved):
+    """A solution of a problem with other weights than the defaults reads back with those weights (its metrics,
+    e.g. the weighted regularisation, are recomputed with them)."""
+    from dataclasses import replace
+
+    from designopt.solution import solve_and_evaluate
+
+    weighted = replace(solved.problem,
+                       waypoint_costs=tuple(replace(c, weight=7.0) for c in solved.problem.waypoint_costs),
+                       design_costs=tuple(replace(c, weight=0.05) for c in solved.problem.design_costs))
+    sol = solve_and_evaluate(weighted, "to", solved.raw)
+    back = Solution.from_dict(to_dict(sol))
+    weights = {c.name: c.weight for c in (*back.problem.waypoint_costs, *back.problem.design_costs)}
+    assert weights == {"deformation": 7.0, "regularization": 0.05}
+    assert back.metrics.regularization == pytest.approx(sol.metrics.regularization, rel=1e-12)
+    assert back.metrics.regularization == pytest.approx(0.05 / 1e-3 * solved.metrics.regularization, rel=1e-12)
+
+
+def test_a_file_reads_back_with_its_own_trajectory(solved):
+    """TO's file says its trajectory is the Hermite cubic through (q, v); the FK baseline's, straight lines."""
+    from designopt.transcriptions.trajectory import HermiteCubic, PiecewiseLinear
+
+    back = Solution.from_dict(to_dict(solved))
+    assert isinstance(back.raw.trajectory, HermiteCubic)
+    t = np.linspace(0, 1, 17)
+    np.testing.assert_allclose(back.sample(t), solved.sample(t), atol=1e-12)
+    data = to_dict(solved)
+    data["trajectory"] = "linear"
+    linear = Solution.from_dict(data)
+    assert isinstance(linear.raw.trajectory, PiecewiseLinear)
+    tp = solved.problem.toolpath
+    mid = 0.5 * (tp.t[3] + tp.t[4])
+    np.testing.assert_allclose(linear.sample(mid)[0], 0.5 * (solved.raw.Q[3] + solved.raw.Q[4]), atol=1e-12)
 
 
 def test_sample_is_the_hermite_trajectory(solved):

@@ -25,16 +25,16 @@ UR10 = ROOT / "configs" / "robots" / "ur10.urdf"
 OFFAXIS = ROOT / "tests" / "data" / "offaxis.urdf"
 
 
-def urdf_problem(path: Path, base: str, tool: str, **robot):
-    cfg = parse_config({"robot": {"urdf": path.name, "base_link": base, "tool_link": tool, **robot},
+def urdf_problem(path: Path, tool: str, design=("placement",)):
+    cfg = parse_config({"robot": {"urdf": path.name, "tool_link": tool}, "design": list(design),
                         "placement": {"xyz": [0.5, 0.0, 0.0]}}, "cfg.yaml", path.parent)
-    return problem_from_config(cfg, path.parent)
+    return problem_from_config(cfg)
 
 
-@pytest.mark.parametrize("path,base,tool,structure", [(UR10, "base_link", "tool0", "RRRRRR"),
+@pytest.mark.parametrize("path,base,tool,structure", [(UR10, "world", "tool0", "RRRRRR"),
                                                       (OFFAXIS, "root", "tip", "RPRR")], ids=["ur10", "offaxis"])
 def test_urdf_chain_matches_pinocchio(path, base, tool, structure, rng):
-    problem = urdf_problem(path, base, tool)
+    problem = urdf_problem(path, tool)  # the chain starts at the URDF's root link (``base``)
     chain = problem.chain
     assert chain.structure == structure
     model = pin.buildModelFromUrdf(str(path))
@@ -56,8 +56,7 @@ def test_urdf_chain_matches_pinocchio(path, base, tool, structure, rng):
 
 
 def test_any_origin_component_is_a_design_joint_by_name():
-    problem = urdf_problem(UR10, "base_link", "tool0", design_origins=["elbow_joint.origin.z",
-                                                                       "wrist_1_joint.origin.z"])
+    problem = urdf_problem(UR10, "tool0", design=["placement", "elbow_joint.origin.z", "wrist_1_joint.origin.z"])
     design = {j.name: j for j in problem.chain.design}
     assert {"elbow_joint.origin.z", "wrist_1_joint.origin.z"} <= set(design)
     assert design["elbow_joint.origin.z"].value == pytest.approx(0.612)  # the UR10's upper-arm length
@@ -71,19 +70,22 @@ def test_any_origin_component_is_a_design_joint_by_name():
 
 
 @pytest.mark.parametrize("robot,key,reason", [
-    ({"urdf": "ur10.urdf", "base_link": "base_link", "tool_link": "nowhere"}, "robot.tool_link", "no link"),
-    ({"urdf": "ur10.urdf", "base_link": "tool0", "tool_link": "base_link"}, "robot.tool_link", "not below"),
-    ({"urdf": "ur10.urdf", "base_link": "base_link", "tool_link": "tool0", "design_origins": ["elbow.origin.q"]},
-     "robot.design_origins", "no origin component"),
-    ({"urdf": "ur10.urdf", "base_link": "base_link", "tool_link": "tool0", "structure": "RRR"}, "robot.structure",
+    ({"robot": {"urdf": "ur10.urdf", "tool_link": "nowhere"}}, "robot.tool_link", "no link"),
+    ({"robot": {"urdf": "ur10.urdf", "tool_link": "world"}}, "robot.tool_link", "root link"),
+    ({"robot": {"urdf": "ur10.urdf", "tool_link": "tool0"}, "design": ["elbow.origin.q"]}, "design",
+     "'elbow.origin.q' names no joint"),
+    ({"robot": {"urdf": "ur10.urdf", "tool_link": "tool0"}, "design": ["a"]}, "design", "not a DH table"),
+    ({"robot": {"urdf": "ur10.urdf", "tool_link": "tool0", "structure": "RRR"}}, "robot.structure",
      "takes its joints from robot.urdf"),
-    ({"urdf": "ur10.urdf", "tool_link": "tool0"}, "robot.base_link", "needed"),
-    ({"urdf": "missing.urdf", "base_link": "a", "tool_link": "b"}, "robot.urdf", "no such file"),
+    ({"robot": {"urdf": "ur10.urdf"}}, "robot.tool_link", "needed"),
+    ({"robot": {"urdf": "ur10.urdf", "tool_link": "tool0", "base_link": "base_link"}}, "robot.base_link",
+     "root link"),
+    ({"robot": {"urdf": "missing.urdf", "tool_link": "b"}}, "robot.urdf", "no such file"),
 ])
 def test_bad_urdf_robot_is_one_line(tmp_path, robot, key, reason):
     (tmp_path / "ur10.urdf").write_text(UR10.read_text())
     config = tmp_path / "c.yaml"
-    config.write_text(yaml.safe_dump({"robot": robot}))
+    config.write_text(yaml.safe_dump(robot))
     result = CliRunner().invoke(app, ["check", str(config)])
     assert result.exit_code == 2, result.output
     lines = [line for line in result.output.splitlines() if line.strip()]
@@ -93,7 +95,7 @@ def test_bad_urdf_robot_is_one_line(tmp_path, robot, key, reason):
 def test_not_a_urdf_is_one_line(tmp_path):
     (tmp_path / "r.urdf").write_text("<robot name='x'><joint name='j' type='revolute'>")
     config = tmp_path / "c.yaml"
-    config.write_text(yaml.safe_dump({"robot": {"urdf": "r.urdf", "base_link": "a", "tool_link": "b"}}))
+    config.write_text(yaml.safe_dump({"robot": {"urdf": "r.urdf", "tool_link": "b"}}))
     result = CliRunner().invoke(app, ["check", str(config)])
     assert result.exit_code == 2 and f"{tmp_path / 'r.urdf'}: (file): not a readable URDF" in result.output
 
@@ -102,10 +104,11 @@ def test_ur10_placement_runs_tracks_and_reverifies(tmp_path):
     cfg = yaml.safe_load((ROOT / "configs" / "ur10_placement.yaml").read_text())
     cfg["robot"]["urdf"] = str(UR10)
     cfg["toolpath"]["waypoints"] = 30
-    cfg["solver"] = {**cfg["solver"], "jobs": 1, "search": {"explore_starts": 4, "refine": 2}}
+    cfg["search"] = {"preset": "quick", "starts": 4}
     config = tmp_path / "ur10.yaml"
     config.write_text(yaml.safe_dump(cfg))
-    result = CliRunner().invoke(app, ["run", str(config), "--out", str(tmp_path / "r"), "--name", "t", "--urdf"])
+    result = CliRunner().invoke(app, ["run", str(config), "--out", str(tmp_path / "r"), "--name", "t", "--urdf",
+                                      "--jobs", "1"])
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "ur10_placement" / "t"
     best = json.loads((run / "best.json").read_text())
@@ -134,3 +137,30 @@ def test_dh_experiments_refuse_a_urdf_robot_with_one_line(command, tmp_path):
     result = CliRunner().invoke(app, [command, str(config), "--out", str(tmp_path)])
     assert result.exit_code == 2 and f"{config}: robot.urdf: " in result.output, result.output
     assert not any(tmp_path.iterdir()), "a run directory was left behind"
+
+
+def test_joints_without_limits_take_the_default_travel(tmp_path):
+    """A continuous joint and joints whose <limit> gives no travel (no lower/upper: URDF reads 0 and 0): the chain
+    moves them within +-2 pi rad and +-2 m (designopt's defaults for joints a file does not limit); a limited joint
+    keeps the file's limits. Pinocchio, reading the same file, agrees on the kinematics."""
+    text = (OFFAXIS.read_text()
+            .replace('<joint name="j1" type="revolute">', '<joint name="j1" type="continuous">')
+            .replace('<limit lower="-0.5" upper="0.5" effort="1" velocity="1"/>', '<limit effort="1" velocity="1"/>')
+            .replace('<limit lower="-2" upper="2" effort="1" velocity="1"/>\n  </joint>\n  <joint name="j4"',
+                     '<limit effort="1" velocity="1"/>\n  </joint>\n  <joint name="j4"'))
+    path = tmp_path / "unlimited.urdf"
+    path.write_text(text)
+    chain = urdf_problem(path, "tip").chain
+    limits = {j.name: (j.lower, j.upper) for j in chain.moving}
+    assert limits == {"j1": (-2 * math.pi, 2 * math.pi), "j2": (-2.0, 2.0), "j3": (-2 * math.pi, 2 * math.pi),
+                      "j4": (-2.0, 2.0)}
+    model = pin.buildModelFromUrdf(str(path))
+    data = model.createData()
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        q_ours = rng.uniform(-1, 1, 4)
+        # pinocchio represents a continuous joint by (cos, sin)
+        q_pin = np.r_[np.cos(q_ours[0]), np.sin(q_ours[0]), q_ours[1:]]
+        pin.framesForwardKinematics(model, data, q_pin)
+        np.testing.assert_allclose(tool_pose(chain, q_ours, chain.design_values),
+                                   data.oMf[model.getFrameId("tip")].homogeneous, atol=1e-9)

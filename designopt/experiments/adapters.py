@@ -1,79 +1,49 @@
-"""Config adapters: from a validated config to the objects experiments run -- the transcription of a method,
-the multistart settings, and the variants of a config that the experiments solve (cases, structures).
+"""Config adapters: from a validated config to the objects experiments hand to the Solve layer -- the search it
+names, and the variants of a config that the experiments solve (cases, structures, path samplings).
 
-The only module that turns solver keys of the config into library objects.
+Variants are made by `designopt.config.revised`, so each is validated like a user's config.
 """
 
 from __future__ import annotations
 
-from designopt.config import Config
+from designopt.config import Config, revised
 from designopt.design_space import enumerate_structures
-from designopt.multistart import Multistart
-from designopt.search import Search
-from designopt.transcriptions import transcription_named
+from designopt.solve.search import Search, preset
 
-__all__ = ["case_config", "describe_search", "enumerate_structures", "multistart_from_config", "search_from_config",
-           "structure_config", "transcription_for", "with_waypoints"]
+__all__ = ["CASES", "case_config", "enumerate_structures", "search_from_config", "structure_config", "with_waypoints"]
 
-
-def transcription_for(cfg: Config, method: str = "to"):
-    """The transcription of ``method`` (to, fk, fk_continuous) with the config's solver settings."""
-    s = cfg.solver
-    options = {"max_iter": s.max_iter, "compile": s.compile, "ipopt": {"ipopt.max_wall_time": float(s.time_limit)}}
-    if method == "to":
-        options.update(kinematics=s.kinematics, tracking=s.tracking, degree=s.degree, hold_degenerate=s.hold_degenerate)
-    return transcription_named(method, **options)
-
-
-def multistart_from_config(cfg: Config) -> Multistart:
-    s = cfg.solver
-    return Multistart(count=s.multistart, seed=s.seed, scale=s.perturbation, init=s.init, jobs=s.jobs)
+# The cases of the continuous problem (SPEC §5): which joints are design joints -- one mechanism.
+CASES = {"placement_only": ["placement"], "design_only": ["d", "a", "alpha"],
+         "combined": ["d", "a", "alpha", "placement"]}
 
 
 def search_from_config(cfg: Config) -> Search:
-    """The library's `Search` from ``solver.search`` (every key but the sweep's ``structure_neighbours``)."""
-    return Search(**cfg.solver.search.model_dump(exclude={"structure_neighbours"}))
+    """The config's search: its preset with the config's seed (and number of starts, when given)."""
+    s = cfg.search
+    return preset(s.preset, seed=s.seed, **({"starts": s.starts} if s.starts is not None else {}))
 
 
-def describe_search(cfg: Config) -> str:
-    """The config's search in words."""
-    s = cfg.solver.search
-    held = "; a solve stalled on a degenerate design is finished held" if cfg.solver.hold_degenerate else ""
-    if s.strategy == "multistart":
-        return f"multistart, {cfg.solver.multistart} starts{held}"
-    screen = (f", the best {s.screen} distinct re-ranked on {s.screen_waypoints} waypoints (<= {s.screen_max_iter} "
-              f"iterations, if the path has more)"
-              if s.screen_waypoints else "")
-    return (f"coarse to fine: {s.explore_starts} starts on {s.explore_waypoints} waypoints (<= {s.explore_max_iter} "
-            f"iterations){screen}, the best {s.refine} distinct optima refined on the full path{held}")
+def _dh_only(cfg: Config, what: str) -> None:
+    if cfg.robot.is_urdf:
+        raise cfg.error("robot.urdf", f"{what} varies DH parameters and needs a DH robot (robot.structure, "
+                                      "robot.dh); `designopt run` takes URDF robots")
 
 
 def case_config(cfg: Config, case: str) -> Config:
     """The config of one case of the continuous problem: the same robot and cell with other joints marked as
     design joints (placement_only, design_only, combined)."""
-    robot, placement = cfg.robot, cfg.placement
-    if robot.is_urdf:
-        raise cfg.error("robot.urdf", "this experiment varies DH parameters and needs a DH robot (robot.structure, "
-                                      "robot.dh); `designopt run` takes URDF robots")
-    design = robot.design or ["d", "a", "alpha"]
-    if case == "placement_only":
-        robot, placement = robot.model_copy(update={"design": []}), placement.model_copy(update={"optimize": True})
-    elif case == "design_only":
-        robot, placement = robot.model_copy(update={"design": design}), placement.model_copy(update={"optimize": False})
-    elif case == "combined":
-        robot, placement = robot.model_copy(update={"design": design}), placement.model_copy(update={"optimize": True})
-    else:
-        raise ValueError(f"unknown case {case!r}")
-    return cfg.model_copy(update={"robot": robot, "placement": placement})
+    _dh_only(cfg, "this experiment")
+    if case not in CASES:
+        raise ValueError(f"unknown case {case!r} ({', '.join(CASES)})")
+    return revised(cfg, design=CASES[case])
 
 
 def with_waypoints(cfg: Config, n: int) -> Config:
-    return cfg.model_copy(update={"toolpath": cfg.toolpath.model_copy(update={"waypoints": n})})
+    return revised(cfg, toolpath={"waypoints": n})
 
 
 def structure_config(cfg: Config, structure: str) -> Config:
-    """The sweep's config for one structure: generic start design, every link's d/theta, a, alpha free."""
-    if cfg.robot.is_urdf:
-        raise cfg.error("robot.urdf", "the structure sweep builds DH robots; a URDF robot has one structure")
-    robot = cfg.robot.model_copy(update={"structure": structure, "dh": "generic", "design": ["d", "a", "alpha"]})
-    return cfg.model_copy(update={"robot": robot})
+    """The sweep's config for one structure: generic start design, every link's d/theta, a, alpha and the
+    placement free."""
+    _dh_only(cfg, "the structure sweep")
+    return revised(cfg, robot={"structure": structure, "dh": "generic"}, design=CASES["combined"])

@@ -7,16 +7,16 @@ the NLP is, and which stiffness model the answer will be stated in.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 
 from designopt.config import Config
 from designopt.costs import Stiffness
-from designopt.experiments.adapters import describe_search, transcription_for
+from designopt.experiments.adapters import search_from_config
 from designopt.kinematics.joints import Joint
 from designopt.problem import problem_from_config
+from designopt.transcriptions import Collocation
 
 
 @dataclass(frozen=True)
@@ -56,14 +56,14 @@ def _describe_cell(cell) -> str:
             f"tool {cell.tool_length:g} m")
 
 
-def check_config(cfg: Config, base_dir: Path) -> ProblemSummary:
-    """Build the problem and its TO NLP (interpreted: no C compile, no solve) and describe them.
+def check_config(cfg: Config) -> ProblemSummary:
+    """Build the problem and its TO NLP (no solve) and describe them.
 
     Raises ConfigError / InputError on bad input, like every command that would solve it.
     """
-    problem = problem_from_config(cfg, base_dir)
+    problem = problem_from_config(cfg)
     t0 = time.perf_counter()
-    nlp = replace(transcription_for(cfg), compile="none").build(problem)
+    nlp = Collocation().build(problem).nlp
     build = time.perf_counter() - t0
     chain, tp = problem.chain, problem.toolpath
     return ProblemSummary(
@@ -73,7 +73,7 @@ def check_config(cfg: Config, base_dir: Path) -> ProblemSummary:
         force_n=float(np.linalg.norm(tp.force_W, axis=1).max()), force_model=tp.force_model,
         tracked=int(tp.is_tracked.sum()), duration=float(tp.t[-1] - tp.t[0]), time_unit=tp.time_unit,
         cell=_describe_cell(problem.cell), stiffness=problem.stiffness,
-        deflection=problem.deflection, tracking=cfg.solver.tracking, kinematics=cfg.solver.kinematics,
+        deflection=problem.deflection, tracking="hard", kinematics="forward",
         n_variables=nlp.n_variables, n_constraints=nlp.n_constraints, build_time_s=build,
-        search=describe_search(cfg),
+        search=search_from_config(cfg).describe(),
     )

@@ -1,11 +1,12 @@
-"""The continuous design problem (SPEC §5-6, claims C1-C3): three cases, three methods, multistart.
+"""The continuous design problem (SPEC §5-6, claims C1-C3): three cases, three methods, one search each.
 
-Cases differ only in which joints are design joints -- one mechanism:
+Cases differ only in which joints are design joints -- one mechanism (`adapters.CASES`):
   placement_only  the configured robot (PUMA-560) is fixed; the 6 placement joints are free
   design_only     the workpiece is fixed at placement.xyz/ypr; d, a, alpha of every link are free (18)
   combined        both (24)
-Methods: ``to`` (collocation), ``fk`` (Whitman et al.), ``fk_continuous`` (FK with bounded joint steps).
-Every (case, method, start) is one joblib task; each finished solve is written at once.
+Methods: ``to`` (collocation), ``fk`` (Whitman et al.), ``fk_continuous`` (FK with bounded joint steps). Every
+(case, method) is one job of the config's search; the shipped config uses the ``paper`` preset, so every method
+gets the same seeded starts, start for start.
 """
 
 from __future__ import annotations
@@ -16,12 +17,16 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.adapters import case_config, multistart_from_config, transcription_for
-from designopt.experiments.tasks import Progress, best_of, multistart_tasks, solve_tasks
+from designopt.experiments.adapters import CASES, case_config, search_from_config
+from designopt.experiments.runs import Executor, Progress
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import write_solution
+from designopt.solve import Job, Search, run_search
 from designopt.tables import best_table
+from designopt.transcriptions import TRANSCRIPTIONS, transcription_named
+
+METHODS = tuple(TRANSCRIPTIONS)
 
 
 @dataclass(frozen=True)
@@ -32,27 +37,23 @@ class ContinuousResult:
     best: dict  # (case, method) -> Solution | None
 
 
-def run_continuous(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                   progress: Progress | None = None, figures: bool = True, experiment: str = "continuous",
-                   resume: bool = False) -> ContinuousResult:
-    settings = multistart_from_config(cfg)
-    tasks = []
-    for case in cfg.continuous.cases:
-        problem = problem_from_config(case_config(cfg, case), base_dir)
-        for method in cfg.continuous.methods:
-            tasks += multistart_tasks(case, method, problem, transcription_for(cfg, method), settings)
+def run_continuous(cfg: Config, out_root: Path, run_name: str | None = None, progress: Progress | None = None,
+                   figures: bool = True, experiment: str = "continuous", resume: bool = False, jobs: int = -1,
+                   cases: tuple[str, ...] = tuple(CASES), methods: tuple[str, ...] = METHODS,
+                   search: Search | None = None) -> ContinuousResult:
+    search = search or search_from_config(cfg)
+    work = []
+    for case in cases:
+        problem = problem_from_config(case_config(cfg, case))
+        work += [Job(case, problem, transcription_named(method)) for method in methods]
     run = RunDirectory.create(out_root, experiment, run_name, resume)  # only once the input is known good
     run.write_config(dump_config(cfg))
-    run.log(f"start continuous: {len(tasks)} solves ({len(cfg.continuous.cases)} cases x "
-            f"{len(cfg.continuous.methods)} methods x {settings.count} starts)")
-    done = solve_tasks(run, tasks, experiment, settings.jobs, resume, progress)
-    groups: dict = {}
-    for task, sol in done:
-        groups.setdefault((task.case, task.method), []).append((task, sol))
-    best_pairs = {key: best_of(pairs) for key, pairs in groups.items()}
+    run.log(f"start continuous: {len(cases)} cases x {len(methods)} methods, search {search.describe()}")
+    searched = run_search(work, search, Executor(run, experiment, jobs, resume, progress))
+    best_pairs = {(s.job.case, s.job.transcription.name): s.best for s in searched}
     best = {key: sol for key, (_, sol) in best_pairs.items()}
     summary = run.mark_best({t.file_name for t, s in best_pairs.values() if s is not None})
-    table = best_table({key: [sol for _, sol in pairs] for key, pairs in groups.items()})
+    table = best_table({(s.job.case, s.job.transcription.name): [sol for _, sol in s.final] for s in searched})
     table.to_csv(run.path / "table.csv", index=False)
     for (case, method), sol in best.items():
         if sol is not None:

@@ -8,6 +8,8 @@ Stages, each written to summary.csv as a ``case``:
   neighbourhood       beyond the paper: a local search over module assignments from the rounded one (one link's
                       module changed at a time, each candidate re-solved like ``modular``; cases nb-<modules>)
   fk                  the FK baseline on the continuous problem, for comparison (C7)
+
+Every stage is a search of one problem (the config's search: the shipped config uses the ``paper`` preset).
 """
 
 from __future__ import annotations
@@ -22,8 +24,8 @@ import pandas as pd
 from designopt.config import Config, dump_config
 from designopt.costs import DesignCost
 from designopt.evaluation import evaluate
-from designopt.experiments.adapters import case_config, multistart_from_config, transcription_for, with_waypoints
-from designopt.experiments.tasks import Progress, Task, multistart_tasks, record, solve_tasks
+from designopt.experiments.adapters import case_config, search_from_config, with_waypoints
+from designopt.experiments.runs import Executor, Progress, record
 from designopt.kinematics.joints import Role
 from designopt.modular import (
     Catalogue,
@@ -33,19 +35,23 @@ from designopt.modular import (
     nearest_modules,
     neighbourhood_search,
 )
-from designopt.multistart import best_solution
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
+from designopt.solve import Job, Search, Seeded, SolverProfile, Task, run_search
+from designopt.transcriptions import ForwardKinematics
 
 STAGES = ("continuous", "continuous_modular", "rounded", "modular", "neighbourhood", "fk")
+WEIGHT = 1.0e-3  # L_mod's weight in the objective
+WEIGHT_STUDY = (1.0e-4, 1.0e-3, 1.0e-2)
+NEIGHBOURHOOD_BUDGET = 48  # module assignments the neighbourhood search may evaluate
+# w_lin (1/m^2) and w_ang of the similarity distance (SPEC §3)
+LINEAR_WEIGHT, ANGULAR_WEIGHT = 1.0, 0.25
 
 
 def catalogue_from_config(cfg: Config) -> Catalogue:
-    m = cfg.modular
-    offset = "d" if m.joint_type == "R" else "theta"
-    modules = tuple((getattr(row, offset), row.a, row.alpha) for row in m.modules)
-    return Catalogue(m.joint_type, modules, m.linear_weight, m.angular_weight)
+    """The config's modules as a catalogue of revolute links (d, a, alpha; theta moves)."""
+    return Catalogue("R", tuple((row.d, row.a, row.alpha) for row in cfg.modules), LINEAR_WEIGHT, ANGULAR_WEIGHT)
 
 
 def with_modular_cost(problem: DesignProblem, catalogue: Catalogue, weight: float) -> DesignProblem:
@@ -75,7 +81,7 @@ def rounded_solution(sol: Solution, assignment: list[int], catalogue: Catalogue)
     values = module_values(sol.problem, assignment, catalogue)
     q_d = np.array([values.get(n, v) for n, v in zip(names, sol.raw.q_d, strict=True)])
     raw = replace(sol.raw, q_d=q_d, status="rounded", success=False, iterations=0, solve_time_s=0.0)
-    return Solution(sol.problem, "rounded", raw, evaluate(sol.problem, q_d, sol.raw.Q), "rounded")
+    return Solution(sol.problem, "rounded", raw, evaluate(sol.problem, q_d, sol.raw.trajectory))
 
 
 @dataclass(frozen=True)
@@ -85,25 +91,25 @@ class ModularResult:
     assignment: list[int]
 
 
-def _stage(run, problem, transcription, settings, case, progress, resume) -> Solution | None:
-    """One stage: a multistart of one problem, written (and resumed) like every experiment."""
-    tasks = multistart_tasks(case, transcription.name, problem, transcription, settings)
-    done = solve_tasks(run, tasks, "modular", settings.jobs, resume, progress)
-    return best_solution([sol for _, sol in done])
+def _stage(setup, problem, case, transcription=None) -> Solution | None:
+    """One stage: the search of one problem, written (and resumed) like every experiment; its best solution."""
+    job = Job(case, problem) if transcription is None else Job(case, problem, transcription)
+    (searched,) = run_search([job], setup.search, setup.execute)
+    return searched.best[1]
 
 
 @dataclass(frozen=True)
 class _Setup:
     catalogue: Catalogue
     run: RunDirectory
-    settings: object
+    search: Search
+    execute: Executor
     combined: Config
     base: DesignProblem
-    to: object
 
 
-def _setup(cfg: Config, base_dir: Path, out_root: Path, experiment: str, run_name: str | None,
-           resume: bool) -> _Setup:
+def _setup(cfg: Config, out_root: Path, experiment: str, run_name: str | None, resume: bool, jobs: int,
+           progress, search: Search | None) -> _Setup:
     """Catalogue (checked against the structure), run directory and the combined design + placement problem."""
     catalogue = catalogue_from_config(cfg)
     try:
@@ -111,33 +117,34 @@ def _setup(cfg: Config, base_dir: Path, out_root: Path, experiment: str, run_nam
     except ValueError as exc:
         raise cfg.error("robot.structure", str(exc)) from None
     combined = case_config(cfg, "combined")
-    base = problem_from_config(combined, base_dir)
+    base = problem_from_config(combined)
     run = RunDirectory.create(out_root, experiment, run_name, resume)
     run.write_config(dump_config(cfg))
-    return _Setup(catalogue, run, multistart_from_config(cfg), combined, base, transcription_for(combined))
+    return _Setup(catalogue, run, search or search_from_config(cfg), Executor(run, experiment, jobs, resume, progress),
+                  combined, base)
 
 
-def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                progress: Progress | None = None, figures: bool = True, resume: bool = False) -> ModularResult:
-    s = _setup(cfg, base_dir, out_root, "modular", run_name, resume)
-    catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
-    best = {"continuous": _stage(run, base, to, settings, "continuous", progress, resume)}
-    best["fk"] = _stage(run, base, transcription_for(combined_cfg, "fk"), settings, "fk", progress, resume)
-    continuous, assignment, modular, placement = _round_and_resolve(run, base, to, settings, catalogue,
-                                                                    cfg.modular.weight, "", progress, resume)
+def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progress: Progress | None = None,
+                figures: bool = True, resume: bool = False, jobs: int = -1, weight: float = WEIGHT,
+                neighbourhood_budget: int = NEIGHBOURHOOD_BUDGET, search: Search | None = None) -> ModularResult:
+    s = _setup(cfg, out_root, "modular", run_name, resume, jobs, progress, search)
+    catalogue, run, base = s.catalogue, s.run, s.base
+    best = {"continuous": _stage(s, base, "continuous")}
+    best["fk"] = _stage(s, base, "fk", ForwardKinematics())
+    continuous, assignment, modular, placement = _round_and_resolve(s, base, catalogue, weight, "")
     best["continuous_modular"], best["modular"] = continuous, modular
     searched = assignment
-    if modular is not None and cfg.modular.neighbourhood_budget:
-        evaluate = ModuleCosts(run, base, to, settings, catalogue, placement, "nb-", progress, resume)
+    if modular is not None and neighbourhood_budget:
+        evaluate = ModuleCosts(s, base, catalogue, placement, "nb-")
         evaluate.best[tuple(assignment)] = modular  # the start is the modular stage, already solved
         searched, _, evaluated = neighbourhood_search([tuple(assignment)], len(catalogue.modules), evaluate,
-                                                      cfg.modular.neighbourhood_budget)
+                                                      neighbourhood_budget)
         best["neighbourhood"] = evaluate.best[tuple(searched)]
         run.log(f"neighbourhood search: {len(evaluated)} assignments evaluated, best {[k + 1 for k in searched]}")
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
         # not a solve: derived from the stage-2 best, so it is recorded once and recomputed on resume
-        rounded_task = Task("rounded", "rounded", base, None, settings, continuous.raw.seed - settings.seed * 1000)
+        rounded_task = Task("rounded", "", base, _Rounded(), SolverProfile(), Seeded(0, continuous.raw.seed))
         if not resume or rounded_task.key not in run.resume():
             record(run, rounded_task, best["rounded"], "modular")
         run.log(f"modules per link: {[k + 1 for k in assignment]}")
@@ -163,18 +170,22 @@ def run_modular(cfg: Config, base_dir: Path, out_root: Path, run_name: str | Non
     return ModularResult(run, table, assignment)
 
 
-def _round_and_resolve(run, base, to, settings, catalogue, weight, tag, progress, resume):
-    """Stages 2-4 for one L_mod weight; returns (continuous best, assignment, modular best)."""
-    continuous = _stage(run, with_modular_cost(base, catalogue, weight), to, settings, f"{tag}continuous_modular",
-                        progress, resume)
+class _Rounded:
+    """The rounded stage is no solve; its row names this method."""
+
+    name = "rounded"
+
+
+def _round_and_resolve(setup, base, catalogue, weight, tag):
+    """Stages 2-4 for one L_mod weight; returns (continuous best, assignment, modular best, placement)."""
+    continuous = _stage(setup, with_modular_cost(base, catalogue, weight), f"{tag}continuous_modular")
     if continuous is None:
         return None, [], None, {}
     assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)
     placed = {j.name for j in base.chain.placement_joints}
     placement = {j.name: float(v) for j, v in zip(base.chain.design, continuous.raw.q_d, strict=True)
                  if j.name in placed}
-    modular = _stage(run, fix_modules(base, assignment, catalogue, placement), to, settings, f"{tag}modular",
-                     progress, resume)
+    modular = _stage(setup, fix_modules(base, assignment, catalogue, placement), f"{tag}modular")
     return continuous, assignment, modular, placement
 
 
@@ -184,25 +195,20 @@ def _digits(assignment) -> str:
 
 class ModuleCosts:
     """``evaluate(assignments) -> costs`` for `neighbourhood_search`: every assignment's modules-fixed problem
-    (placement and trajectory free, from the rounded stage's placement) solved like the ``modular`` stage, all
-    of a batch in one fan-out (cases ``<tag><module numbers>``); NaN when no start tracks. ``best`` keeps each
+    (placement and trajectory free, from the rounded stage's placement) searched like the ``modular`` stage, all
+    of a batch in one search (cases ``<tag><module numbers>``); NaN when no start tracks. ``best`` keeps each
     evaluated assignment's best solution."""
 
-    def __init__(self, run, base, to, settings, catalogue, placement, tag, progress, resume):
-        self.args = run, base, to, settings, catalogue, placement
-        self.tag, self.progress, self.resume = tag, progress, resume
+    def __init__(self, setup, base, catalogue, placement, tag):
+        self.setup, self.base, self.catalogue, self.placement, self.tag = setup, base, catalogue, placement, tag
         self.best: dict[tuple[int, ...], Solution | None] = {}
 
     def __call__(self, batch):
-        run, base, to, settings, catalogue, placement = self.args
         todo = [a for a in batch if a not in self.best]  # known already: e.g. the rounded assignment's re-solve
-        tasks = []
-        for a in todo:
-            tasks += multistart_tasks(f"{self.tag}{_digits(a)}", to.name, fix_modules(base, list(a), catalogue,
-                                                                                      placement), to, settings)
-        done = solve_tasks(run, tasks, "modular", settings.jobs, self.resume, self.progress)
-        for a in todo:
-            self.best[a] = best_solution([sol for t, sol in done if t.case == f"{self.tag}{_digits(a)}"])
+        jobs = [Job(f"{self.tag}{_digits(a)}", fix_modules(self.base, list(a), self.catalogue, self.placement))
+                for a in todo]
+        for a, searched in zip(todo, run_search(jobs, self.setup.search, self.setup.execute), strict=True):
+            self.best[a] = searched.best[1]
         return [self.best[a].metrics.design_cost if self.best[a] is not None else np.nan for a in batch]
 
 
@@ -213,55 +219,56 @@ class ModularStudyResult:
     enumeration: pd.DataFrame  # every assignment of the small catalogue, ranked; rounding's pick marked
 
 
-def run_modular_study(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                      progress: Progress | None = None, resume: bool = False) -> ModularStudyResult:
+def run_modular_study(cfg: Config, out_root: Path, run_name: str | None = None, progress: Progress | None = None,
+                      resume: bool = False, jobs: int = -1, weights: tuple[float, ...] = WEIGHT_STUDY,
+                      weight: float = WEIGHT, enumeration_modules: tuple[int, ...] = (2, 5),
+                      enumeration_waypoints: int = 40,
+                      neighbourhood_budget: int = NEIGHBOURHOOD_BUDGET,
+                      search: Search | None = None) -> ModularStudyResult:
     """Beyond the paper: (a) how the L_mod weight changes the result; (b) on a small catalogue where every
-    assignment can be solved, how far rounding lands from the best assignment."""
+    assignment can be solved (``enumeration_modules``, 1-based, on ``enumeration_waypoints`` waypoints), how far
+    rounding lands from the best assignment."""
     import itertools
 
-    s = _setup(cfg, base_dir, out_root, "modular_study", run_name, resume)
-    catalogue, run, settings, combined_cfg, base, to = s.catalogue, s.run, s.settings, s.combined, s.base, s.to
+    if any(not 1 <= k <= len(cfg.modules) for k in enumeration_modules):
+        raise cfg.error("modules", f"the enumeration uses modules {list(enumeration_modules)}; the catalogue has "
+                                   f"{len(cfg.modules)}")
+    s = _setup(cfg, out_root, "modular_study", run_name, resume, jobs, progress, search)
+    catalogue, run, base = s.catalogue, s.run, s.base
 
-    weights = []
-    for w in cfg.modular.weight_study:
-        cont, assignment, mod, _ = _round_and_resolve(run, base, to, settings, catalogue, w, f"w{w:g}-", progress,
-                                                      resume)
-        weights.append({"weight": w, "continuous_cost": cont.metrics.design_cost if cont else np.nan,
-                        "L_mod": modular_cost(base.chain, cont.raw.q_d, catalogue) if cont else np.nan,
-                        "modules": " ".join(f"m{k + 1}" for k in assignment),
-                        "modular_cost": mod.metrics.design_cost if mod else np.nan})
-    weight_table = pd.DataFrame(weights)
+    rows = []
+    for w in weights:
+        cont, assignment, mod, _ = _round_and_resolve(s, base, catalogue, w, f"w{w:g}-")
+        rows.append({"weight": w, "continuous_cost": cont.metrics.design_cost if cont else np.nan,
+                     "L_mod": modular_cost(base.chain, cont.raw.q_d, catalogue) if cont else np.nan,
+                     "modules": " ".join(f"m{k + 1}" for k in assignment),
+                     "modular_cost": mod.metrics.design_cost if mod else np.nan})
+    weight_table = pd.DataFrame(rows)
     weight_table.to_csv(run.path / "weight_study.csv", index=False)
 
     # (b) enumeration on a sub-catalogue and a shorter path
-    subset = [k - 1 for k in cfg.modular.enumeration_modules]
+    subset = [k - 1 for k in enumeration_modules]
     small = replace(catalogue, modules=tuple(catalogue.modules[k] for k in subset))
-    n = cfg.modular.enumeration_waypoints
-    small_cfg = with_waypoints(combined_cfg, n)
-    small_base = problem_from_config(small_cfg, base_dir)
-    small_to = transcription_for(small_cfg)
-    _, rounded_assignment, rounded_best, _ = _round_and_resolve(run, small_base, small_to, settings, small,
-                                                                cfg.modular.weight, "enum-", progress, resume)
+    small_base = problem_from_config(with_waypoints(s.combined, enumeration_waypoints))
+    _, rounded_assignment, rounded_best, _ = _round_and_resolve(s, small_base, small, weight, "enum-")
     placement = {j.name: j.value for j in small_base.chain.placement_joints if j.role is Role.DESIGN}
-    rows = []
-    for assignment in itertools.product(range(len(subset)), repeat=small_base.chain.n_links):
-        best = _stage(run, fix_modules(small_base, list(assignment), small, placement), small_to, settings,
-                      "enum-" + "".join(str(subset[k] + 1) for k in assignment), progress, resume)
-        rows.append({"assignment": " ".join(f"m{subset[k] + 1}" for k in assignment),
-                     "design_cost": best.metrics.design_cost if best else np.nan,
-                     "rounding_picked": list(assignment) == rounded_assignment})
+    assignments = list(itertools.product(range(len(subset)), repeat=small_base.chain.n_links))
+    found = run_search([Job("enum-" + "".join(str(subset[k] + 1) for k in a),
+                            fix_modules(small_base, list(a), small, placement)) for a in assignments],
+                       s.search, s.execute)
+    rows = [{"assignment": " ".join(f"m{subset[k] + 1}" for k in a),
+             "design_cost": f.best[1].metrics.design_cost if f.best[1] else np.nan,
+             "rounding_picked": list(a) == rounded_assignment} for a, f in zip(assignments, found, strict=True)]
     enum = pd.DataFrame(rows).sort_values("design_cost", na_position="last").reset_index(drop=True)
     enum["rank"] = np.arange(1, len(enum) + 1)
     # the neighbourhood search from the rounded assignment, on the same solves (every assignment is enumerated)
-    by_assignment = {tuple(int(k) for k in a): c for a, c in zip(
-        itertools.product(range(len(subset)), repeat=small_base.chain.n_links), [r["design_cost"] for r in rows],
-        strict=True)}
+    by_assignment = {tuple(int(k) for k in a): r["design_cost"] for a, r in zip(assignments, rows, strict=True)}
     enum["neighbourhood_picked"] = False
-    if rounded_assignment and cfg.modular.neighbourhood_budget:
-        found, _, evaluated = neighbourhood_search([tuple(rounded_assignment)], len(subset),
-                                                   lambda batch: [by_assignment[a] for a in batch],
-                                                   cfg.modular.neighbourhood_budget)
-        label = " ".join(f"m{subset[k] + 1}" for k in found)
+    if rounded_assignment and neighbourhood_budget:
+        picked, _, evaluated = neighbourhood_search([tuple(rounded_assignment)], len(subset),
+                                                    lambda batch: [by_assignment[a] for a in batch],
+                                                    neighbourhood_budget)
+        label = " ".join(f"m{subset[k] + 1}" for k in picked)
         enum["neighbourhood_picked"] = enum["assignment"] == label
         run.log(f"neighbourhood search from the rounded assignment: {label} after {len(evaluated)} of "
                 f"{len(enum)} assignments, rank {int(enum.loc[enum['neighbourhood_picked'], 'rank'].iloc[0])}")

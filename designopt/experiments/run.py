@@ -1,4 +1,4 @@
-"""``designopt run``: one config, one searched TO problem (designopt.search), one run directory."""
+"""``designopt run``: one config, one searched problem (`designopt.solve.search`), one run directory."""
 
 from __future__ import annotations
 
@@ -8,16 +8,12 @@ from pathlib import Path
 import pandas as pd
 
 from designopt.config import Config, dump_config
-from designopt.experiments.adapters import (
-    describe_search,
-    multistart_from_config,
-    search_from_config,
-    transcription_for,
-)
-from designopt.experiments.tasks import Progress, Searched, best_of, search_problem
+from designopt.experiments.adapters import search_from_config
+from designopt.experiments.runs import Executor, Progress
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
+from designopt.solve import Job, Search, Searched, run_search
 from designopt.tables import best_so_far, solution_set
 
 
@@ -44,19 +40,19 @@ class RunResult:
     solution_set: pd.DataFrame  # the distinct local optima reached, best first (tables.solution_set)
 
 
-def run_experiment(cfg: Config, base_dir: Path, out_root: Path, run_name: str | None = None,
-                   progress: Progress | None = None, figures: bool = True, resume: bool = False) -> RunResult:
-    """Solve the config's problem with multistart TO and write the run directory (``resume``: finish the
-    named run, solving only the starts it has no solution for)."""
-    problem = problem_from_config(cfg, base_dir)
+def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, progress: Progress | None = None,
+                   figures: bool = True, resume: bool = False, jobs: int = -1,
+                   search: Search | None = None) -> RunResult:
+    """Search the config's problem (with the config's search, or ``search``) and write the run directory
+    (``resume``: finish the named run, solving only the starts it has no solution for)."""
+    problem = problem_from_config(cfg)
+    search = search or search_from_config(cfg)
     run = RunDirectory.create(out_root, cfg.name, run_name, resume)
     run.write_config(dump_config(cfg))
     run.log(f"start {cfg.name}: structure {problem.chain.structure}, {problem.chain.n_design} design joints, "
-            f"{problem.toolpath.n} waypoints, search {describe_search(cfg)}")
-    settings, search = multistart_from_config(cfg), search_from_config(cfg)
-    searched = search_problem(run, "", problem, transcription_for(cfg), settings, search, cfg.name, settings.jobs,
-                              resume, progress)
-    best_task, best = best_of(searched.final)
+            f"{problem.toolpath.n} waypoints, search {search.describe()}")
+    (searched,) = run_search([Job("", problem)], search, Executor(run, cfg.name, jobs, resume, progress))
+    best_task, best = searched.best
     summary = run.mark_best({best_task.file_name} if best is not None else set())
     solutions = [sol for _, sol in searched.explore + searched.final]
     optima = searched_set(searched)
@@ -64,7 +60,7 @@ def run_experiment(cfg: Config, base_dir: Path, out_root: Path, run_name: str | 
     if figures:
         from designopt import plots_experiments
 
-        explored = summary[summary["case"] == "explore"] if searched.explore else summary
+        explored = summary[summary["stage"] == "explore"] if searched.explore else summary
         plots_experiments.search_progress_figure(best_so_far(explored.reset_index(drop=True)), optima, run.figures)
     if best is not None:
         write_solution(best, run.path / "best.json")

@@ -1,17 +1,16 @@
-"""Robots from URDF: a serial chain between two links, built into the same elementary-transform chain as a
-DH robot.
+"""Robots from URDF: the serial chain from the file's root link to a tool link, built into the same
+elementary-transform chain as a DH robot.
 
-Every URDF joint on the way from ``base_link`` to ``tool_link`` contributes its origin -- six ETs
-x, y, z, yaw, pitch, roll (URDF's rpy is Rz(yaw) Ry(pitch) Rx(roll)), each a joint named
-``<joint>.origin.<component>`` that is fixed unless named a design joint -- followed, for a revolute,
-continuous or prismatic joint, by its motion about or along its axis (a moving joint named after the URDF
-joint, with the URDF's limits). The tool frame is ``tool_link``'s frame.
+Every URDF joint on the way from the root to ``tool_link`` contributes its origin -- six ETs x, y, z, yaw, pitch,
+roll (URDF's rpy is Rz(yaw) Ry(pitch) Rx(roll)), each a fixed joint named ``<joint>.origin.<component>`` that a
+design space may make a design joint (`designopt.design_space.design_joint_names`) -- followed, for a revolute,
+continuous or prismatic joint, by its motion about or along its axis (a moving joint named after the URDF joint,
+with the URDF's limits). The tool frame is ``tool_link``'s frame.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -32,19 +31,25 @@ def rpy_of(R: np.ndarray) -> tuple[float, float, float]:
     return 0.0, pitch, math.atan2(-R[0, 1], R[1, 1])  # gimbal lock: put it all in yaw
 
 
-def serial_joints(urdf, base_link: str, tool_link: str, config_error) -> list:
-    """The URDF joints from base_link down to tool_link, in order."""
+def root_link(urdf) -> str:
+    """The link that is no joint's child."""
+    children = {j.child for j in urdf.robot.joints}
+    roots = [link.name for link in urdf.robot.links if link.name not in children]
+    return roots[0]
+
+
+def serial_joints(urdf, tool_link: str, config_error) -> list:
+    """The URDF joints from the root link down to tool_link, in order."""
     links = {link.name for link in urdf.robot.links}
-    for key, name in (("robot.base_link", base_link), ("robot.tool_link", tool_link)):
-        if name not in links:
-            raise config_error(key, f"no link {name!r} in the URDF (links: {', '.join(sorted(links))})")
+    if tool_link not in links:
+        raise config_error("robot.tool_link", f"no link {tool_link!r} in the URDF (links: {', '.join(sorted(links))})")
     by_child = {j.child: j for j in urdf.robot.joints}
     path, link = [], tool_link
-    while link != base_link:
-        if link not in by_child:
-            raise config_error("robot.tool_link", f"{tool_link!r} is not below {base_link!r} in the URDF tree")
+    while link in by_child:
         path.append(by_child[link])
         link = by_child[link].parent
+    if link == tool_link:
+        raise config_error("robot.tool_link", f"{tool_link!r} is the URDF's root link: the tool must be below it")
     return path[::-1]
 
 
@@ -58,40 +63,37 @@ def load_urdf(path: Path):
         raise InputError(path, "(file)", f"not a readable URDF: {reason}") from None
 
 
-def chain_from_urdf(path: Path, base_link: str, tool_link: str, design: Sequence[str], placement: list[Joint],
-                    placement_ets: tuple[ET, ...], length_bounds: tuple[float, float],
-                    angle_bounds: tuple[float, float], revolute: tuple[float, float],
-                    prismatic: tuple[float, float], config_error=None) -> Chain:
-    """The chain of a URDF robot after the given placement joints.
+def chain_from_urdf(path: Path, tool_link: str, placement: list[Joint], placement_ets: tuple[ET, ...], bounds,
+                    config_error=None) -> Chain:
+    """The chain of a URDF robot after the given placement joints, every origin component fixed.
 
-    ``design`` names origin components that become design joints (``elbow_joint.origin.z``); joint limits
-    come from the URDF (continuous joints, and joints without limits, take ``revolute``/``prismatic``).
-    ``config_error(key, reason)`` makes the exception for a mistake in the config (not in the URDF).
+    Joint limits come from the URDF (continuous joints, and joints without limits, take ``bounds.revolute`` /
+    ``bounds.prismatic``, a `designopt.design_space.JointBounds`); origin components, should a design space free
+    them, are bounded by ``bounds.design_length`` / ``bounds.design_angle``. ``config_error(key, reason)`` makes
+    the exception for a mistake in the config (not in the URDF).
     """
     if config_error is None:
         def config_error(key, reason):
             return InputError("<config>", key, reason)
     urdf = load_urdf(path)
     joints, robot, frames = list(placement), [], []
-    known = set()
-    for uj in serial_joints(urdf, base_link, tool_link, config_error):
+    for uj in serial_joints(urdf, tool_link, config_error):
         origin = np.asarray(uj.origin if uj.origin is not None else np.eye(4), dtype=float)
         roll, pitch, yaw = rpy_of(origin[:3, :3])
         values = dict(zip(("x", "y", "z"), origin[:3, 3], strict=True)) | {"yaw": yaw, "pitch": pitch, "roll": roll}
         for component, motion, axis in ORIGIN:
             name = f"{uj.name}.origin.{component}"
-            known.add(name)
             length = motion == "translate"
-            lo, hi = length_bounds if length else angle_bounds
-            role = Role.DESIGN if name in design else Role.FIXED
+            lo, hi = bounds.design_length if length else bounds.design_angle
             tags = frozenset({REGULARISED}) if length else frozenset()
             robot.append(ET(motion, axis, len(joints)))
-            joints.append(Joint(name, "length" if length else "angle", role, float(values[component]), lo, hi, tags))
+            joints.append(Joint(name, "length" if length else "angle", Role.FIXED, float(values[component]), lo, hi,
+                                tags))
         if uj.type in MOVING_TYPES:
             motion = MOVING_TYPES[uj.type]
             axis = np.asarray(uj.axis if uj.axis is not None else (1.0, 0.0, 0.0), dtype=float)
             axis = tuple(float(v) for v in axis / np.linalg.norm(axis))
-            lo, hi = revolute if motion == "rotate" else prismatic
+            lo, hi = bounds.revolute if motion == "rotate" else bounds.prismatic
             if uj.type != "continuous" and uj.limit is not None and uj.limit.lower is not None \
                     and uj.limit.upper is not None and uj.limit.lower < uj.limit.upper:
                 lo, hi = float(uj.limit.lower), float(uj.limit.upper)
@@ -101,8 +103,4 @@ def chain_from_urdf(path: Path, base_link: str, tool_link: str, design: Sequence
             raise InputError(path, "robot.urdf", f"joint {uj.name!r} is {uj.type}: only revolute, continuous, "
                                                  "prismatic and fixed joints make a serial chain")
         frames.append(len(robot))
-    unknown = sorted(set(design) - known)
-    if unknown:
-        raise config_error("robot.design_origins", f"no origin component {unknown[0]!r} on the way from "
-                                                   f"{base_link!r} to {tool_link!r}")
     return Chain(joints=tuple(joints), placement=placement_ets, robot=tuple(robot), frames=tuple(frames))

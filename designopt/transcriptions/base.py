@@ -8,6 +8,7 @@ import casadi as ca
 import numpy as np
 
 from designopt.problem import DesignProblem
+from designopt.transcriptions.trajectory import HermiteCubic, PiecewiseLinear
 
 
 @dataclass(frozen=True)
@@ -22,11 +23,11 @@ class InitialGuess:
 
 @dataclass(frozen=True)
 class RawResult:
-    """What a solver returned, before any metric is computed. Times in seconds."""
+    """What a solver returned, before any metric is computed: the design joints and the joint trajectory (the
+    transcription's own kind, `designopt.transcriptions.trajectory`). Times in seconds."""
 
     q_d: np.ndarray
-    Q: np.ndarray
-    V: np.ndarray | None
+    trajectory: HermiteCubic | PiecewiseLinear
     status: str
     success: bool
     iterations: int
@@ -37,7 +38,17 @@ class RawResult:
     n_constraints: int
     seed: int = 0
     kinematic_drift: float = 0.0
-    held: str = ""  # design joints held on a degenerate design to finish the solve (transcriptions.degeneracy)
+    held: str = ""  # design joints held on a degenerate design to finish the solve (solve.strategies.continuation)
+
+    @property
+    def Q(self) -> np.ndarray:
+        """Joint values at the waypoints (N x n_m)."""
+        return self.trajectory.Q
+
+    @property
+    def V(self) -> np.ndarray | None:
+        """Joint velocities at the waypoints (N x n_m), when the trajectory has them."""
+        return self.trajectory.V
 
 
 def waypoint_function(problem: DesignProblem) -> ca.Function:
@@ -60,18 +71,3 @@ def waypoint_function(problem: DesignProblem) -> ca.Function:
         "waypoint", [q, q_d, s_W, f_W], [w.p_W, w.z_W, s_B[0] ** 2 + s_B[1] ** 2, R_BW.T @ w.J[:3, :]],
         ["q", "q_d", "s_W", "f_W"], ["p_W", "z_W", "rho2", "Jv_W"],
     )
-
-
-def ipopt_options(max_iter: int, extra: dict | None = None) -> dict:
-    """IPOPT settings shared by all transcriptions: quiet, exact Hessian, MUMPS."""
-    opts = {
-        "ipopt.max_iter": int(max_iter),
-        "ipopt.print_level": 0,
-        "ipopt.sb": "yes",
-        "print_time": False,
-        "ipopt.tol": 1e-8,
-        "ipopt.acceptable_tol": 1e-6,
-        "ipopt.acceptable_iter": 10,
-    }
-    opts.update(extra or {})
-    return opts

@@ -9,25 +9,24 @@ Tracking is ``hard`` (position and tool axis as equality constraints at every wa
 ``soft`` (the paper's penalty w * L_t). Kinematics is ``forward`` (p = FK(q)) or ``differential``
 (p is a state with dp/dt = J(q) dq/dt, integrated by Simpson's rule over each interval, p_0 = FK(q_0)).
 
-The NLP is built once per problem; `CollocationNLP.solve` then runs from any number of initial guesses.
+The NLP is built once per problem shape and solved by any backend from any number of initial guesses
+(`designopt.solve`); the trajectory between the knots is `HermiteCubic`.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from designopt.problem import DesignProblem
-from designopt.transcriptions.base import InitialGuess, RawResult, waypoint_function
-from designopt.transcriptions.compiled import COMPILE_MODES
-from designopt.transcriptions.degeneracy import DegenerateWatch
+from designopt.transcriptions.base import InitialGuess, waypoint_function
 from designopt.transcriptions.nlp import (
+    NLP,
     BlockStructure,
     ConstraintList,
-    WaypointNLP,
     clearance_terms,
     floor_terms,
     free_untracked,
@@ -39,20 +38,7 @@ from designopt.transcriptions.nlp import (
     waypoint_terms,
     y_indices,
 )
-
-
-def hermite_midpoint(q0, v0, q1, v1, h):
-    """Position and velocity of the cubic Hermite segment at its midpoint (numpy or CasADi)."""
-    q_mid = 0.5 * (q0 + q1) + h * (v0 - v1) / 8.0
-    v_mid = 1.5 * (q1 - q0) / h - 0.25 * (v0 + v1)
-    return q_mid, v_mid
-
-
-def hermite_acceleration_integral(q0, v0, q1, v1, h):
-    """Integral of the squared acceleration over one cubic Hermite segment (exact), per joint."""
-    a0 = 6.0 * (q1 - q0) / h**2 - (4.0 * v0 + 2.0 * v1) / h
-    a1 = -6.0 * (q1 - q0) / h**2 + (2.0 * v0 + 4.0 * v1) / h
-    return h / 3.0 * (a0 * a0 + a0 * a1 + a1 * a1)
+from designopt.transcriptions.trajectory import HermiteCubic, hermite_acceleration_integral, hermite_midpoint
 
 
 @dataclass(frozen=True)
@@ -60,20 +46,23 @@ class Collocation:
     """The TO transcription: swap it for another transcription of the same DesignProblem.
 
     ``hessian``: ``structured`` assembles the exact Hessian from per-waypoint blocks (forward kinematics
-    only), ``auto`` lets CasADi differentiate the whole graph. ``compile``: C-compile the block function
-    (``none``, ``O0``, ``O1``, ``O2``).
+    only), ``auto`` lets the backend differentiate the whole graph.
     """
 
     kinematics: str = "forward"
     tracking: str = "hard"
     degree: int = 3
-    max_iter: int = 3000
     hessian: str = "structured"
-    compile: str = "O0"
-    ipopt: dict = field(default_factory=dict)
-    hold_degenerate: bool = True  # finish a stalled solve on a degenerate design with its angles held (multistart)
 
     name = "to"
+    trajectory_kind = HermiteCubic.kind
+
+    @property
+    def exact_tracking(self) -> bool:
+        """Whether the tool's position and axis are equality constraints of the design joints and the joints at
+        every waypoint (hard tracking, forward kinematics): the rows `designopt.transcriptions.degeneracy`
+        analyses."""
+        return self.tracking == "hard" and self.kinematics == "forward"
 
     def __post_init__(self):
         if self.degree != 3:
@@ -84,15 +73,17 @@ class Collocation:
             raise ValueError(f"tracking must be hard or soft, got {self.tracking!r}")
         if self.hessian not in ("structured", "auto"):
             raise ValueError(f"hessian must be structured or auto, got {self.hessian!r}")
-        if self.compile not in COMPILE_MODES:
-            raise ValueError(f"compile must be one of {COMPILE_MODES}, got {self.compile!r}")
 
     def build(self, problem: DesignProblem) -> CollocationNLP:
         return CollocationNLP(problem, self)
 
+    def trajectory(self, t, Q, V) -> HermiteCubic:
+        """The joint trajectory the knots (q_k, v_k) define."""
+        return HermiteCubic(np.asarray(t, float), np.asarray(Q, float), np.asarray(V, float))
+
 
 class CollocationNLP:
-    """The built NLP of one problem; `solve` runs IPOPT from an initial guess."""
+    """The built NLP of one problem (`nlp`), and how guesses and answers map onto its decision vector."""
 
     def __init__(self, problem: DesignProblem, scheme: Collocation):
         t0 = time.perf_counter()
@@ -169,13 +160,12 @@ class CollocationNLP:
                                       (M, np.hstack([mid_index, np.tile(np.arange(n_d), (N - 1, 1))]), N - 1)):
                 first = cons.size
                 cons.add(clear.map(count)(ca.vertcat(points, ca.repmat(q_d, 1, count)))[1], 0.0, np.inf)
-                cell_blocks.append(BlockStructure(clear, at, first + np.arange(count * n_cl).reshape(count, n_cl),
-                                                  scheme.compile, ()))
+                cell_blocks.append(BlockStructure(clear, at, first + np.arange(count * n_cl).reshape(count, n_cl), ()))
             floor = floor_terms(problem)
             first = cons.size
             cons.add(floor(q_d)[1], 0.0, np.inf)
             cell_blocks.append(BlockStructure(floor, np.arange(n_d)[None, :],
-                                              first + np.arange(floor.size1_out(1))[None, :], scheme.compile, ()))
+                                              first + np.arange(floor.size1_out(1))[None, :], ()))
 
         n_free = self.n_state - 2 * n_m
         state_lo = np.concatenate([lo_m, -vmax * np.ones(n_m), -np.inf * np.ones(n_free)])
@@ -185,20 +175,15 @@ class CollocationNLP:
         ubx = np.concatenate([[j.upper for j in chain.design], np.tile(state_hi, N), mid_hi])
         blocks = None
         if scheme.hessian == "structured" and not differential:
-            blocks = [BlockStructure(terms, y_indices(n_d, n_m, N, self.n_state), np.arange(N * n_c).reshape(N, n_c),
-                                     scheme.compile), *cell_blocks]
+            blocks = [BlockStructure(terms, y_indices(n_d, n_m, N, self.n_state), np.arange(N * n_c).reshape(N, n_c)),
+                      *cell_blocks]
         elif problem.cell is not None:
             raise ValueError("clearance constraints need the structured Hessian and forward kinematics")
-        watch = None
-        if scheme.hold_degenerate and scheme.tracking == "hard" and not differential:
-            watch = DegenerateWatch(problem, x.shape[0], cons.size)
-        self.nlp = WaypointNLP(problem, "to", x, objective, quadratic, cons, lbx, ubx, blocks, scheme.max_iter,
-                               scheme.ipopt, t0, watch)
-        self.solver, self.lbx, self.ubx = self.nlp.solver, self.nlp.lbx, self.nlp.ubx
-        self.n_variables, self.n_constraints = self.nlp.n_variables, self.nlp.n_constraints
-        self.build_time_s = self.nlp.build_time_s
+        self.nlp = NLP(problem, "to", x, objective, quadratic, cons, lbx, ubx, blocks)
+        self.build_time_s = time.perf_counter() - t0
 
-    def _pack(self, guess: InitialGuess) -> np.ndarray:
+    def pack(self, guess: InitialGuess) -> np.ndarray:
+        """The decision vector of a guess: design joints, knot states (q_k, v_k[, p_k]), collocation points."""
         p = self.problem
         Q = np.asarray(guess.Q, dtype=float)
         V = np.gradient(Q, p.toolpath.t, axis=0) if guess.V is None else np.asarray(guess.V, dtype=float)
@@ -213,13 +198,12 @@ class CollocationNLP:
             mid = [hermite_midpoint(Q[:-1], V[:-1], Q[1:], V[1:], h)[0].ravel()]  # row k = column k of M
         return np.concatenate([np.asarray(guess.q_d, dtype=float), Z.ravel(), *mid])
 
-    def solve(self, guess: InitialGuess) -> RawResult:
-        """Run IPOPT from one guess. A failed solve is a result with its status, not an exception."""
-        x, objective, stats, wall = self.nlp.run(self._pack(guess))
+    def unpack(self, x: np.ndarray) -> tuple[np.ndarray, HermiteCubic, float]:
+        """(design joints, joint trajectory, kinematic drift in m) of a decision vector."""
         n_d, n_m, N = self.problem.chain.n_design, self.problem.chain.n_moving, self.problem.toolpath.n
         Z = x[n_d : n_d + N * self.n_state].reshape(N, self.n_state)
         drift = float(self._drift(x)) if self.scheme.kinematics == "differential" else 0.0
-        return self.nlp.result(x[:n_d], Z[:, :n_m], Z[:, n_m : 2 * n_m], objective, stats, wall, guess.seed, drift)
+        return x[:n_d], self.scheme.trajectory(self.problem.toolpath.t, Z[:, :n_m], Z[:, n_m : 2 * n_m]), drift
 
 
 def _pdot(Jv_W, V, n_m: int, n: int):

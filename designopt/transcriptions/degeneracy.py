@@ -8,8 +8,8 @@ iteration cap or fails in restoration (docs/benchmarks.md, "The design-only stal
 
 The set is a piece of the feasible set on its own: with the design angles that put the arm there held, and each
 row that no longer depends on the joints imposed once (`q_independent_rows`), the problem is regular again.
-`held_at_multiples_of_pi` builds that problem from a design; `designopt.multistart` re-solves a start that
-ended there without converging.
+`held_at_multiples_of_pi` builds that problem from a design; `designopt.solve.observers.DegenerateWatch` stops a
+solve that sits there, and `designopt.solve.strategies.continuation` finishes it on the held problem.
 """
 
 from __future__ import annotations
@@ -93,57 +93,3 @@ def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3) -> t
     if len(q_independent_rows(candidate)) <= len(q_independent_rows(problem)):
         return None  # e.g. a PPP gantry, whose axis rows never depended on its joints: nothing degenerates here
     return candidate, q_d
-
-
-class DegenerateWatch(ca.Callback):
-    """IPOPT's per-iteration callback that stops a solve once its design has sat on a degenerate design
-    (`held_at_multiples_of_pi` would hold something) for ``patience`` iterations in a row: from there IPOPT only
-    creeps (cause 3), and `designopt.multistart` finishes the solve with those angles held instead.
-
-    ``x`` is laid out design joints first (q_d = x[:n_d]). ``stopped`` tells whether the last solve was stopped
-    here. A solve that only passes through such a design is not stopped."""
-
-    def __init__(self, problem: DesignProblem, n_x: int, n_g: int, patience: int = 30, tol: float = 1e-3):
-        ca.Callback.__init__(self)
-        self.problem, self.n_x, self.n_g, self.patience, self.tol = problem, n_x, n_g, patience, tol
-        # held joints (lower == upper) are not watched: a problem already held there must be allowed to finish
-        self.angle = np.array([j.kind == "angle" and j.lower < j.upper for j in problem.chain.design], dtype=bool)
-        self._verdicts: dict[tuple[bool, ...], bool] = {}
-        self.run = 0
-        self.stopped = False
-        self.construct("degenerate_watch", {})
-
-    def reset(self) -> None:
-        self.run, self.stopped = 0, False
-
-    def get_n_in(self):
-        return ca.nlpsol_n_out()
-
-    def get_n_out(self):
-        return 1
-
-    def get_name_in(self, i):
-        return ca.nlpsol_out(i)
-
-    def get_name_out(self, i):
-        return "ret"
-
-    def get_sparsity_in(self, i):
-        name = ca.nlpsol_out(i)
-        n = {"x": self.n_x, "lam_x": self.n_x, "g": self.n_g, "lam_g": self.n_g, "f": 1}.get(name, 0)
-        return ca.Sparsity.dense(n, 1)
-
-    def _degenerate(self, q_d: np.ndarray) -> bool:
-        near = self.angle & (np.abs(q_d - np.round(q_d / np.pi) * np.pi) <= self.tol)
-        if not near.any():
-            return False
-        key = tuple(near)
-        if key not in self._verdicts:
-            self._verdicts[key] = held_at_multiples_of_pi(self.problem, q_d, self.tol) is not None
-        return self._verdicts[key]
-
-    def eval(self, arg):
-        q_d = np.asarray(arg[0]).ravel()[: len(self.angle)]
-        self.run = self.run + 1 if self._degenerate(q_d) else 0
-        self.stopped = self.run >= self.patience
-        return [1 if self.stopped else 0]

@@ -13,18 +13,17 @@ position error <= position_tol and axis error <= position_tol <= axis_tol).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from designopt.problem import DesignProblem
-from designopt.transcriptions.base import InitialGuess, RawResult
-from designopt.transcriptions.compiled import COMPILE_MODES
+from designopt.transcriptions.base import InitialGuess
 from designopt.transcriptions.nlp import (
+    NLP,
     BlockStructure,
     ConstraintList,
-    WaypointNLP,
     free_untracked,
     joint_regularization,
     quadratic_design_costs,
@@ -33,6 +32,7 @@ from designopt.transcriptions.nlp import (
     waypoint_terms,
     y_indices,
 )
+from designopt.transcriptions.trajectory import PiecewiseLinear
 
 
 @dataclass(frozen=True)
@@ -42,16 +42,14 @@ class ForwardKinematics:
 
     continuous: bool = False
     epsilon: float | None = None
-    max_iter: int = 3000
-    compile: str = "O0"
     hessian: str = "structured"
-    ipopt: dict = field(default_factory=dict)
+
+    exact_tracking = False  # tracking within epsilon: nothing degenerates the way hard equalities do
+    trajectory_kind = PiecewiseLinear.kind
 
     def __post_init__(self):
         if self.hessian not in ("structured", "auto"):
             raise ValueError(f"hessian must be structured or auto, got {self.hessian!r}")
-        if self.compile not in COMPILE_MODES:
-            raise ValueError(f"compile must be one of {COMPILE_MODES}, got {self.compile!r}")
 
     @property
     def name(self) -> str:
@@ -59,6 +57,10 @@ class ForwardKinematics:
 
     def build(self, problem: DesignProblem) -> ForwardKinematicsNLP:
         return ForwardKinematicsNLP(problem, self)
+
+    def trajectory(self, t, Q, V=None) -> PiecewiseLinear:
+        """Joint values at the waypoints; straight lines between them are all the baseline defines."""
+        return PiecewiseLinear(np.asarray(t, float), np.asarray(Q, float))
 
 
 class ForwardKinematicsNLP:
@@ -94,16 +96,15 @@ class ForwardKinematicsNLP:
         hi_m = [j.upper for j in chain.moving]
         lbx = np.concatenate([[j.lower for j in chain.design], np.tile(lo_m, N)])
         ubx = np.concatenate([[j.upper for j in chain.design], np.tile(hi_m, N)])
-        blocks = None if scheme.hessian == "auto" else BlockStructure(
-            terms, y_indices(n_d, n_m, N, n_m), np.arange(N * n_c).reshape(N, n_c), scheme.compile)
-        self.nlp = WaypointNLP(problem, scheme.name, x, objective, quadratic, cons, lbx, ubx, blocks,
-                               scheme.max_iter, scheme.ipopt, t0)
-        self.n_variables, self.n_constraints = self.nlp.n_variables, self.nlp.n_constraints
-        self.build_time_s = self.nlp.build_time_s
+        blocks = None if scheme.hessian == "auto" else [BlockStructure(
+            terms, y_indices(n_d, n_m, N, n_m), np.arange(N * n_c).reshape(N, n_c))]
+        self.nlp = NLP(problem, scheme.name, x, objective, quadratic, cons, lbx, ubx, blocks)
+        self.build_time_s = time.perf_counter() - t0
 
-    def solve(self, guess: InitialGuess) -> RawResult:
-        """Run IPOPT from one guess (only q_d and Q are used: FK has no velocities)."""
-        x0 = np.concatenate([np.asarray(guess.q_d, float), np.asarray(guess.Q, float).ravel()])
-        x, objective, stats, wall = self.nlp.run(x0)
+    def pack(self, guess: InitialGuess) -> np.ndarray:
+        """Design joints, then the joints at every waypoint (FK has no velocities)."""
+        return np.concatenate([np.asarray(guess.q_d, float), np.asarray(guess.Q, float).ravel()])
+
+    def unpack(self, x: np.ndarray) -> tuple[np.ndarray, PiecewiseLinear, float]:
         n_d, n_m, N = self.problem.chain.n_design, self.problem.chain.n_moving, self.problem.toolpath.n
-        return self.nlp.result(x[:n_d], x[n_d:].reshape(N, n_m), None, objective, stats, wall, guess.seed)
+        return x[:n_d], self.scheme.trajectory(self.problem.toolpath.t, x[n_d:].reshape(N, n_m)), 0.0

@@ -34,14 +34,15 @@ def assemble_hessian(
     n_x: int,
     n_g: int,
     groups: list[tuple[ca.Function, np.ndarray, list, np.ndarray]],
-    constant: np.ndarray,
+    constant: tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> ca.Function:
     """hess_lag(x, p, lam_f, lam_g) -> triu Hessian, for nlpsol's ``hess_lag`` option.
 
     Each group is (block, y_index, block_inputs, mu_index): a block Hessian function evaluated at N points,
     ``y_index`` (N x n_y) the position in x of each block variable, ``mu_index`` (N x n_c) the position in
     lam_g of each block multiplier, ``block_inputs`` the block's constant extra inputs (mapped). ``constant``
-    is the dense Hessian of the quadratic terms, scaled by lam_f. Contributions to one entry add up.
+    is the upper-triangular Hessian of the quadratic terms as triplets (rows, cols, values), scaled by lam_f.
+    Contributions to one entry add up.
     """
     rows, cols = [], []
     for _, y_index, _, _ in groups:
@@ -52,7 +53,7 @@ def assemble_hessian(
                 i, j = y_index[k, a], y_index[k, b]
                 rows.append(min(i, j))
                 cols.append(max(i, j))
-    c_rows, c_cols = np.nonzero(np.triu(constant))
+    c_rows, c_cols, c_values = (np.asarray(a) for a in constant)
     # CasADi stores nonzeros column by column: order the (row, col) pairs the same way.
     all_pairs = sorted(set(zip(rows, cols, strict=True)) | set(zip(c_rows, c_cols, strict=True)),
                        key=lambda rc: (rc[1], rc[0]))
@@ -63,7 +64,7 @@ def assemble_hessian(
     scatter = ca.DM.triplet(list(block_nz), list(range(len(block_nz))), ca.DM.ones(len(block_nz)), sp.nnz(),
                             len(block_nz))
     const_vals = np.zeros(sp.nnz())
-    const_vals[const_nz] = constant[c_rows, c_cols]
+    np.add.at(const_vals, const_nz, c_values)
 
     x = ca.MX.sym("x", n_x)
     p = ca.MX.sym("p", 0, 1)

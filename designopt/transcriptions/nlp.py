@@ -1,13 +1,12 @@
-"""The part every transcription shares: per-waypoint terms in y_k = (q_k, q_d), an NLP with the exact
-structured Hessian, and a solve that turns IPOPT's answer into a RawResult.
+"""The part every transcription shares: per-waypoint terms in y_k = (q_k, q_d) and the backend-neutral `NLP` whose
+exact Hessian is assembled from per-waypoint blocks.
 
-A transcription decides the decision vector layout, the objective and the constraints; `WaypointNLP`
-does the rest.
+A transcription decides the decision vector layout, the objective and the constraints; `NLP` holds them for a
+backend (`designopt.solve.backends`) to solve.
 """
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import casadi as ca
@@ -15,11 +14,8 @@ import numpy as np
 
 from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
-from designopt.transcriptions.base import RawResult, ipopt_options
 from designopt.transcriptions.degeneracy import q_independent_rows
 from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
-
-PRE_ITERATION_STATUSES = {"Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition", "Invalid_Option"}
 
 
 @dataclass
@@ -52,68 +48,54 @@ class BlockStructure:
     terms: ca.Function
     y_index: np.ndarray
     mu_index: np.ndarray
-    compile: str
     inputs: tuple | None = None
 
 
-# the status of a solve its `DegenerateWatch` stopped (IPOPT itself says User_Requested_Stop)
-STOPPED_DEGENERATE = "Stopped_On_Degenerate_Design"
+class NLP:
+    """A transcribed problem, backend-neutral: decision vector ``x``, objective ``f``, constraints ``g`` (CasADi SX)
+    and their bounds, plus where the per-point nonlinear terms sit (``blocks``), from which `hessian` assembles
+    the exact Hessian of the Lagrangian; ``quadratic`` is the part of ``f`` whose Hessian is constant.
 
-
-class WaypointNLP:
-    """An IPOPT problem whose nonlinear terms are per-waypoint blocks (plus quadratic terms)."""
+    Built once per problem shape; a backend (`designopt.solve.backends`) turns it into a solver. The design
+    joints come first in ``x`` (x[:n_design])."""
 
     def __init__(self, problem: DesignProblem, name: str, x, objective, quadratic, constraints: ConstraintList,
-                 lbx, ubx, blocks: BlockStructure | list[BlockStructure] | None, max_iter: int, ipopt: dict | None,
-                 t_start: float, watch=None):
-        self.problem, self.watch = problem, watch
-        g, self.lbg, self.ubg = constraints.stacked()
+                 lbx, ubx, blocks: list[BlockStructure] | None):
+        self.problem, self.name = problem, name
+        self.x, self.f = x, objective
+        self.g, self.lbg, self.ubg = constraints.stacked()
         self.lbx, self.ubx = np.asarray(lbx, float), np.asarray(ubx, float)
-        self.n_variables, self.n_constraints = x.shape[0], g.shape[0]
+        self.n_variables, self.n_constraints = x.shape[0], self.g.shape[0]
         self.n_equalities = int(np.sum(self.lbg == self.ubg))
-        opts = ipopt_options(max_iter, ipopt)
-        if blocks is not None:
+        self.n_design = problem.chain.n_design
+        self.blocks, self.quadratic = blocks, quadratic
+        self._hessians: dict[str, object] = {}
+
+    def hessian(self, compile_mode: str):
+        """hess_lag(x, p, lam_f, lam_g) from the per-point blocks (each block function compiled per
+        ``compile_mode``: `designopt.transcriptions.compiled`), or None when the NLP has no block structure."""
+        if self.blocks is None:
+            return None
+        if compile_mode not in self._hessians:
             groups = []
-            for b in [blocks] if isinstance(blocks, BlockStructure) else blocks:
-                block = block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1], b.compile)
-                inputs = list(waypoint_inputs(problem.toolpath) if b.inputs is None else b.inputs)
+            for b in self.blocks:
+                block = block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1], compile_mode)
+                inputs = list(waypoint_inputs(self.problem.toolpath) if b.inputs is None else b.inputs)
                 groups.append((block, b.y_index, inputs, b.mu_index))
-            constant = np.array(ca.evalf(ca.hessian(quadratic, x)[0])) if not isinstance(quadratic, (int, float)) \
-                else np.zeros((x.shape[0], x.shape[0]))
-            opts["hess_lag"] = assemble_hessian(self.n_variables, self.n_constraints, groups, constant)
-        if watch is not None:
-            opts["iteration_callback"] = watch
-        self.solver = ca.nlpsol(name, "ipopt", {"x": x, "f": objective, "g": g}, opts)
-        self.build_time_s = time.perf_counter() - t_start
+            self._hessians[compile_mode] = assemble_hessian(self.n_variables, self.n_constraints, groups,
+                                                            constant_hessian(self.quadratic, self.x))
+        return self._hessians[compile_mode]
 
-    def run(self, x0: np.ndarray):
-        """Solve from x0; returns (x, objective, stats, wall time)."""
-        x0 = np.clip(x0, self.lbx, self.ubx)
-        if self.watch is not None:
-            self.watch.reset()
-        if self.n_equalities > self.n_variables:
-            # IPOPT would stop here before its first iteration, but only after CasADi printed a warning on the
-            # terminal, once per solve (a sweep's one-joint structures: hundreds of lines).
-            return x0, float("nan"), {"return_status": "Not_Enough_Degrees_Of_Freedom", "success": False}, 0.0
-        t0 = time.perf_counter()
-        sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
-        wall = time.perf_counter() - t0
-        return np.asarray(sol["x"]).ravel(), float(sol["f"]), self.solver.stats(), wall
 
-    def result(self, q_d, Q, V, objective, stats, wall, seed, drift=0.0) -> RawResult:
-        status = str(stats.get("return_status", "unknown"))
-        if self.watch is not None and self.watch.stopped:
-            status = STOPPED_DEGENERATE
-        # IPOPT stops these before its first iteration, and the reported count is then stale.
-        iterations = 0 if status in PRE_ITERATION_STATUSES else int(stats.get("iter_count", -1))
-        return RawResult(
-            q_d=q_d, Q=Q, V=V,
-            status=status,
-            success=bool(stats.get("success", False)),
-            iterations=iterations,
-            solve_time_s=wall, build_time_s=self.build_time_s, objective=objective,
-            n_variables=self.n_variables, n_constraints=self.n_constraints, seed=seed, kinematic_drift=drift,
-        )
+def constant_hessian(quadratic, x) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Hessian of the quadratic terms as sparse upper-triangular triplets (rows, cols, values)."""
+    if isinstance(quadratic, (int, float)):
+        return np.zeros(0, int), np.zeros(0, int), np.zeros(0)
+    H = ca.evalf(ca.triu(ca.hessian(quadratic, x)[0]))
+    rows, cols = H.sparsity().get_triplet()
+    values = np.array(H.nonzeros(), dtype=float)
+    keep = values != 0
+    return np.asarray(rows, int)[keep], np.asarray(cols, int)[keep], values[keep]
 
 
 def y_indices(n_d: int, n_m: int, N: int, stride: int) -> np.ndarray:

@@ -1,0 +1,58 @@
+"""One local solve: a problem, its transcription, a solver profile and one initial guess -> a `Solution`.
+
+A worker process builds a problem's NLP once (per transcription) and prepares it once per profile, and reuses both
+for every start it is given: the caches below live in the worker. Keys are the content of the problem and the
+transcription, so two starts of the same problem share one build whatever objects they came in.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+import pickle
+import time
+
+from designopt.problem import DesignProblem
+from designopt.solution import Solution, solve_and_evaluate
+from designopt.solve.backends import backend_named
+from designopt.solve.profile import SolverProfile
+from designopt.transcriptions.base import InitialGuess, RawResult
+
+# IPOPT's linear algebra gains nothing from threads at this size; parallelism is across starts.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+
+@functools.lru_cache(maxsize=4)
+def _built(key: str, payload: bytes):
+    problem, transcription = pickle.loads(payload)
+    return transcription.build(problem)
+
+
+@functools.lru_cache(maxsize=8)
+def _prepared(key: str, payload: bytes, profile: SolverProfile):
+    built = _built(key, payload)
+    return built, backend_named(profile.backend).prepare(built.nlp, profile)
+
+
+def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
+    """(built NLP, prepared solver, seconds this call spent building and preparing: 0 when both were cached)."""
+    payload = pickle.dumps((problem, transcription))
+    key = hashlib.sha256(payload).hexdigest()
+    t0 = time.perf_counter()
+    misses = _prepared.cache_info().misses
+    built, solver = _prepared(key, payload, profile)
+    return built, solver, (time.perf_counter() - t0) if _prepared.cache_info().misses > misses else 0.0
+
+
+def solve_guess(problem: DesignProblem, transcription, profile: SolverProfile, guess: InitialGuess) -> Solution:
+    """Solve the problem from ``guess``. A solve that fails is a solution with its status, not an exception."""
+    built, solver, spent = prepared(problem, transcription, profile)
+    outcome = solver.solve(built.pack(guess))
+    q_d, trajectory, drift = built.unpack(outcome.x)
+    raw = RawResult(q_d=q_d, trajectory=trajectory, status=outcome.status, success=outcome.success,
+                    iterations=outcome.iterations, solve_time_s=outcome.solve_time_s, build_time_s=spent,
+                    objective=outcome.objective, n_variables=built.nlp.n_variables,
+                    n_constraints=built.nlp.n_constraints, seed=guess.seed, kinematic_drift=drift)
+    return solve_and_evaluate(problem, transcription.name, raw)

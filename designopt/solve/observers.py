@@ -1,0 +1,56 @@
+"""Observers: watch a solve's iterates and may stop it; they never change the problem or the iterate.
+
+An observer is made per prepared solver from the problem (``OBSERVERS[name](problem)``); a backend calls
+``observe(q_d, iterations)`` with the design joints every few iterations (``iterations`` since the last call) and
+stops the solve when it returns True; the solve's status is then the observer's ``status``. What happens next
+(a continuation on another problem) is a strategy's business (`designopt.solve.strategies.continuation`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from designopt.problem import DesignProblem
+from designopt.transcriptions.degeneracy import held_at_multiples_of_pi
+
+
+class DegenerateWatch:
+    """Stops a solve once its design has sat on a degenerate design (`held_at_multiples_of_pi` would hold
+    something: every joint axis parallel to the workpiece normal, docs/decisions.md) for ``patience`` iterations
+    in a row: from there IPOPT only creeps. A solve that only passes through such a design is not stopped.
+    Held joints (lower == upper) are not watched: a problem already held there must be allowed to finish."""
+
+    status = "Stopped_On_Degenerate_Design"
+
+    def __init__(self, problem: DesignProblem, patience: int = 30, tol: float = 1e-3):
+        self.problem, self.patience, self.tol = problem, patience, tol
+        self.angle = np.array([j.kind == "angle" and j.lower < j.upper for j in problem.chain.design], dtype=bool)
+        self._verdicts: dict[tuple[bool, ...], bool] = {}
+        self.reset()
+
+    def reset(self) -> None:
+        self.run, self.stopped = 0, False
+
+    def _degenerate(self, q_d: np.ndarray) -> bool:
+        near = self.angle & (np.abs(q_d - np.round(q_d / np.pi) * np.pi) <= self.tol)
+        if not near.any():
+            return False
+        key = tuple(near)
+        if key not in self._verdicts:  # the analysis is exact per set of near-pi angles: once per set
+            self._verdicts[key] = held_at_multiples_of_pi(self.problem, q_d, self.tol) is not None
+        return self._verdicts[key]
+
+    def observe(self, q_d: np.ndarray, iterations: int = 1) -> bool:
+        self.run = self.run + iterations if self._degenerate(np.asarray(q_d, float)) else 0
+        self.stopped = self.run >= self.patience
+        return self.stopped
+
+
+OBSERVERS = {"degenerate": DegenerateWatch}
+
+
+def make_observers(names, problem: DesignProblem) -> list:
+    unknown = [n for n in names if n not in OBSERVERS]
+    if unknown:
+        raise ValueError(f"unknown observer {unknown[0]!r} ({', '.join(OBSERVERS)})")
+    return [OBSERVERS[n](problem) for n in names]

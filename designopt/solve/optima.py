@@ -1,0 +1,53 @@
+"""Local optima: when two designs are the same optimum, the distinct ones among many solutions, the best one.
+
+Designs are compared joint by joint: metres for lengths, radians (wrapped) for angles.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def design_distance(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> float:
+    """Largest difference between two designs: metres for lengths, radians (wrapped to [-pi, pi]) for angles."""
+    d = np.asarray(a, float) - np.asarray(b, float)
+    d = np.where(angle, np.arctan2(np.sin(d), np.cos(d)), d)
+    return float(np.max(np.abs(d))) if d.size else 0.0
+
+
+def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, tol: float = 0.02) -> np.ndarray:
+    """Label each design with its local optimum: in order of cost, a design joins the first (cheaper) cluster
+    whose representative lies within ``tol`` (m or rad) in every design joint, else starts a new one."""
+    order = np.argsort(costs, kind="stable")
+    labels, leaders = np.empty(len(costs), dtype=int), []
+    for i in order:
+        for k, j in enumerate(leaders):
+            if design_distance(designs[i], designs[j], angle) <= tol:
+                labels[i] = k
+                break
+        else:
+            labels[i] = len(leaders)
+            leaders.append(i)
+    return labels
+
+
+def distinct_best(solutions: list, count: int, tol: float = 0.02) -> list[int]:
+    """Indices into ``solutions`` of the best tracking solution of each of the ``count`` cheapest distinct
+    optima (`cluster_designs`), cheapest first."""
+    tracking = [i for i, s in enumerate(solutions) if s.metrics.tracks]
+    if not tracking or count <= 0:
+        return []
+    angle = np.array([j.kind == "angle" for j in solutions[tracking[0]].problem.chain.design], dtype=bool)
+    costs = np.array([solutions[i].metrics.design_cost for i in tracking])
+    labels = cluster_designs(np.array([solutions[i].raw.q_d for i in tracking]).reshape(len(tracking), -1), costs,
+                             angle, tol)
+    leaders = {}
+    for k in np.argsort(costs, kind="stable"):
+        leaders.setdefault(labels[k], tracking[k])
+    return list(leaders.values())[:count]
+
+
+def best_solution(solutions):
+    """The tracking solution with the lowest design cost (None if none tracks)."""
+    tracking = [s for s in solutions if s.metrics.tracks]
+    return min(tracking, key=lambda s: s.metrics.design_cost) if tracking else None

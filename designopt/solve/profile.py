@@ -1,0 +1,50 @@
+"""Solver profiles: which backend solves an NLP, and how (caps, warm or cold, observers).
+
+A profile is a small frozen value: the search derives the profile of every stage from one base profile
+(``capped`` for a coarse exploration, ``warmed`` for a solve that starts at a solution of another sampling), and
+a worker caches one prepared solver per (NLP, profile). Nothing in a profile changes the problem being solved,
+only how the backend goes about it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+COMPILE_MODES = ("none", "O0", "O1", "O2")
+
+
+@dataclass(frozen=True)
+class SolverProfile:
+    """How one NLP is solved.
+
+    ``backend``: a name in `designopt.solve.backends.BACKENDS`. ``max_iter``: iteration cap. ``time_limit``:
+    wall seconds per solve. ``warm``: the guess is a solution of a neighbouring problem (another sampling of
+    the path, the same design held): start the barrier small and do not push the guess off its active bounds.
+    ``compile``: how the per-waypoint derivative blocks are evaluated (``none``: interpreted; ``O0``-``O2``:
+    C compiled at that level, cached on disk). ``observers``: names in `designopt.solve.observers.OBSERVERS`,
+    watching every iteration; an observer may stop a solve, never change it.
+    """
+
+    backend: str = "ipopt"
+    max_iter: int = 1000
+    time_limit: float = 300.0
+    warm: bool = False
+    compile: str = "O0"
+    observers: tuple[str, ...] = ()
+    options: tuple[tuple[str, float | int | str], ...] = ()
+
+    def __post_init__(self):
+        if self.compile not in COMPILE_MODES:
+            raise ValueError(f"compile must be one of {COMPILE_MODES}, got {self.compile!r}")
+        if self.max_iter < 1 or self.time_limit <= 0:
+            raise ValueError("max_iter must be >= 1 and time_limit > 0")
+
+    def capped(self, max_iter: int | None) -> SolverProfile:
+        """The same profile with at most ``max_iter`` iterations (None: unchanged)."""
+        return self if max_iter is None else replace(self, max_iter=min(self.max_iter, max_iter))
+
+    def warmed(self) -> SolverProfile:
+        return replace(self, warm=True)
+
+    def observing(self, *names: str) -> SolverProfile:
+        return replace(self, observers=tuple(dict.fromkeys((*self.observers, *names))))

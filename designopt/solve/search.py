@@ -1,0 +1,119 @@
+"""The search: how a set of problems is solved, from which starts, on which paths, and when to stop.
+
+Local optima are everywhere in design problems: the same task from different seeded starts ends anywhere between
+the best design known and thousands of times its cost. A `Search` names a strategy (one module each under
+`designopt.solve.strategies`) and its budget; `PRESETS` are the named searches a config picks
+(``search: {preset: ...}``). What a search is given is a list of `Job`s (the problems an experiment describes);
+what it returns is one `Searched` per job. `designopt.solve.strategies.run_search` drives it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+from designopt.problem import DesignProblem
+from designopt.solution import Solution
+from designopt.solve.optima import best_solution
+from designopt.solve.profile import SolverProfile
+from designopt.solve.tasks import Task
+from designopt.transcriptions import Collocation
+
+
+@dataclass(frozen=True)
+class Search:
+    """A strategy and its budget. Counts are per problem; iteration caps per solve.
+
+    ``starts`` seeded starts (from ``seed``; perturbation ``perturbation``, joints by ``init``): cold starts on
+    the full path for ``multistart``; for ``coarse_to_fine`` the exploration's starts on ``explore_waypoints`` of
+    the path's waypoints (each capped at ``explore_max_iter``), the ``screen`` best distinct of which are re-ranked
+    on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no more waypoints), and the
+    ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
+    design joint are one optimum. ``hold_degenerate``: a solve stalled on a degenerate design is finished with
+    the design held there (`strategies.continuation`). ``structure_neighbours``: after the strategy, one more
+    start per problem from each neighbouring structure's better design (`strategies.neighbours`; only problems
+    whose structures differ in one joint type are neighbours). ``profile``: the full-path solves' solver profile.
+    """
+
+    strategy: str = "coarse_to_fine"
+    starts: int = 80
+    seed: int = 0
+    perturbation: float = 0.3
+    init: str = "ik"
+    explore_waypoints: int = 10
+    explore_max_iter: int = 250
+    screen_waypoints: int = 40
+    screen: int = 12
+    screen_max_iter: int = 300
+    refine: int = 4
+    distinct: float = 0.02
+    hold_degenerate: bool = True
+    structure_neighbours: bool = True
+    profile: SolverProfile = field(default_factory=SolverProfile)
+
+    def describe(self) -> str:
+        """The search in words."""
+        held = "; a solve stalled on a degenerate design is finished held" if self.hold_degenerate else ""
+        cap = f"<= {self.profile.max_iter} iterations"
+        if self.strategy == "multistart":
+            return f"multistart: {self.starts} seeded starts on the full path ({cap}){held}"
+        screen = (f", the best {self.screen} distinct re-ranked on {self.screen_waypoints} waypoints "
+                  f"(<= {self.screen_max_iter} iterations, if the path has more)" if self.screen_waypoints else "")
+        return (f"coarse to fine: {self.starts} starts on {self.explore_waypoints} waypoints (<= "
+                f"{self.explore_max_iter} iterations){screen}, the best {self.refine} distinct optima refined on the "
+                f"full path ({cap}){held}")
+
+
+PRESETS: dict[str, Search] = {
+    # a structure sweep's per-structure search: half the default's starts and refinements, tighter caps
+    "quick": Search(starts=40, refine=2, profile=SolverProfile(max_iter=600, time_limit=60.0)),
+    "default": Search(),
+    "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
+    # the paper's comparisons: every method gets the same seeded cold starts on the full path, start for start
+    "paper": Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0)),
+}
+
+
+def preset(name: str, **overrides) -> Search:
+    """A named search with some fields replaced (e.g. ``seed``, ``starts``)."""
+    if name not in PRESETS:
+        raise ValueError(f"unknown search preset {name!r} ({', '.join(PRESETS)})")
+    return replace(PRESETS[name], **overrides)
+
+
+@dataclass(frozen=True, eq=False)
+class Job:
+    """One problem to search: what an experiment describes. ``case`` names it in the run's files (jobs of one
+    search differ in case, method or structure); ``transcription`` is how it becomes an NLP (TO by default)."""
+
+    case: str
+    problem: DesignProblem
+    transcription: object = field(default_factory=Collocation)
+
+    @property
+    def identity(self) -> tuple[str, str, str]:
+        return self.case, self.transcription.name, self.problem.chain.structure
+
+
+@dataclass(frozen=True, eq=False)
+class Searched:
+    """What a search of one job solved: ``explore`` (solves on coarser paths, empty for ``multistart``) and
+    ``final`` (full-path solves, the ones an answer is chosen from), each as (task, solution) in start order."""
+
+    job: Job
+    explore: list[tuple[Task, Solution]]
+    final: list[tuple[Task, Solution]]
+
+    @property
+    def best(self) -> tuple[Task | None, Solution | None]:
+        """(task, solution) of the best tracking full-path solve, or (None, None)."""
+        best = best_solution([sol for _, sol in self.final])
+        return next(((t, s) for t, s in self.final if s is best), (None, None))
+
+
+def by_job(jobs: list[Job], done: list[tuple[Task, Solution]]) -> list[list[tuple[Task, Solution]]]:
+    """Split (task, solution) pairs by the job they belong to, each list in start order."""
+    where = {job.identity: k for k, job in enumerate(jobs)}
+    out = [[] for _ in jobs]
+    for task, sol in done:
+        out[where[task.case, task.method, task.problem.chain.structure]].append((task, sol))
+    return [sorted(d, key=lambda d: d[0].seed) for d in out]

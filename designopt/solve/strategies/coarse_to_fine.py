@@ -1,0 +1,63 @@
+"""Coarse to fine: explore many cheap starts on a coarse sampling of the path, refine the best distinct optima.
+
+A start's objective after a few hundred IPOPT iterations barely predicts where it ends; the same problem on fewer
+waypoints does: a design optimal for a coarse sampling of the path lies, more often than not, in the basin of a
+design optimal for the full path. Stages, each across every problem:
+
+1. ``explore``: ``search.starts`` cold seeded starts of the *coarse problem* -- the same robot, placement, costs and
+   cell on ``explore_waypoints`` of the path's waypoints (`coarse_problem`) -- each capped at
+   ``explore_max_iter``. A coarse solve costs about a tenth of a full one.
+2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
+   optima lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter`` and ranked again there:
+   the coarse ranking alone often puts a design that lifts badly ahead of one that lifts well.
+3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
+   trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from designopt.problem import DesignProblem
+from designopt.solve.optima import distinct_best
+from designopt.solve.search import Searched, by_job
+from designopt.solve.starts import Lifted
+from designopt.solve.strategies.steps import seeded_tasks, solve_setup
+from designopt.solve.tasks import Task
+from designopt.toolpaths import subsample
+
+
+def coarse_problem(problem: DesignProblem, waypoints: int) -> DesignProblem:
+    """The same problem on ``waypoints`` of its path's waypoints (first and last kept)."""
+    return replace(problem, toolpath=subsample(problem.toolpath, waypoints))
+
+
+def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, search, max_iter: int | None = None):
+    """For every job, its ``count`` best distinct solutions lifted to ``waypoints`` (None: the full path), each
+    solved warm within ``max_iter`` iterations (None: the profile's own cap)."""
+    tasks = []
+    for job, done in zip(jobs, found, strict=True):
+        problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
+        profile, continuation = solve_setup(job, search, search.profile.warmed().capped(max_iter))
+        for i in distinct_best([sol for _, sol in done], count, search.distinct):
+            tasks.append(Task(job.case, stage, problem, job.transcription, profile, Lifted(done[i][1]), continuation))
+    return tasks
+
+
+def plan(jobs, search):
+    explore = []
+    for job in jobs:
+        coarse = coarse_problem(job.problem, search.explore_waypoints)
+        explore += seeded_tasks(job, "explore", coarse, search.profile.capped(search.explore_max_iter), search,
+                                search.starts)
+    explored = by_job(jobs, (yield explore))
+    candidates = explored
+    screened = [k for k, job in enumerate(jobs) if 0 < search.screen_waypoints < job.problem.toolpath.n]
+    if screened:
+        sub = [jobs[k] for k in screened]
+        tasks = lifted_tasks(sub, [explored[k] for k in screened], search.screen, "screen", search.screen_waypoints,
+                             search, search.screen_max_iter)
+        found = dict(zip(screened, by_job(sub, (yield tasks)), strict=True))
+        candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
+    final = by_job(jobs, (yield lifted_tasks(jobs, candidates, search.refine, "refine", None, search)))
+    return [Searched(job, e, f) for job, e, f in zip(jobs, explored, final, strict=True)]

@@ -1,0 +1,25 @@
+"""What every strategy's tasks share: the profile and continuation of a job's solves, and seeded starts."""
+
+from __future__ import annotations
+
+from designopt.solve.search import Job, Search
+from designopt.solve.starts import Seeded
+from designopt.solve.strategies.continuation import HoldDegenerate
+from designopt.solve.tasks import Task
+
+
+def solve_setup(job: Job, search: Search, profile=None):
+    """(profile, continuation) of a job's solves: the search's profile (or ``profile``) watching for degenerate
+    designs, and the continuation that finishes such a solve, when the search holds them and the job's
+    transcription tracks exactly."""
+    profile = profile or search.profile
+    if search.hold_degenerate and getattr(job.transcription, "exact_tracking", False):
+        return profile.observing(HoldDegenerate.observer), HoldDegenerate()
+    return profile, None
+
+
+def seeded_tasks(job: Job, stage: str, problem, profile, search: Search, count: int) -> list[Task]:
+    """``count`` seeded starts of ``problem`` (the job's, or a coarser sampling of it)."""
+    profile, continuation = solve_setup(job, search, profile)
+    return [Task(job.case, stage, problem, job.transcription, profile,
+                 Seeded(search.seed, i, search.perturbation, search.init), continuation) for i in range(count)]
