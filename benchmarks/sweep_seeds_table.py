@@ -1,4 +1,4 @@
-"""Claims C4-C6 side by side over sweep runs of different search seeds (issue 11): a markdown table.
+"""Claims C4-C6 side by side over sweep runs of different search seeds: a markdown table.
 
     .venv/bin/python benchmarks/sweep_seeds_table.py RUN0/table.csv RUN1/table.csv [...]
 
@@ -9,7 +9,7 @@ it, PPP's rank among 3-DOF structures, and the spread (max/min) between runs.
 
 from __future__ import annotations
 
-import sys
+import argparse
 
 import pandas as pd
 
@@ -43,4 +43,6 @@ def main(paths: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("tables", nargs="+", help="table.csv of each sweep run")
+    main(parser.parse_args().tables)
