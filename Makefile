@@ -4,7 +4,7 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup run test test-slow mutate lint figures benchmark clean view-check
+.PHONY: setup run test test-slow mutate lint figures benchmark clean view-check corpus
 
 setup: $(STAMP)
 
@@ -14,10 +14,22 @@ $(STAMP): pyproject.toml
 	$(BIN)/pip install --quiet -e ".[dev]"
 	touch $(STAMP)
 
+# Real CNC programs for the tests (tests/data/gcode/SOURCES.md): the example programs a PyPI package ships, taken
+# from its wheel at install time (never committed).
+CORPUS := $(VENV)/gcode-corpus
+corpus: $(CORPUS)/.extracted
+
+$(CORPUS)/.extracted: $(STAMP)
+	$(BIN)/pip download --quiet --no-deps --dest $(CORPUS) carvera-controller-community==2026.8.22
+	$(BIN)/python -c "import zipfile, glob; z = zipfile.ZipFile(glob.glob('$(CORPUS)/*.whl')[0]); \
+	[z.extract(n, '$(CORPUS)') for n in z.namelist() if n.startswith('carveracontroller/gcodes/') \
+	or n.endswith(('LICENSE', 'NOTICE', 'METADATA'))]"
+	touch $@
+
 run: setup
 	$(BIN)/designopt run configs/milling.yaml
 
-test: setup
+test: setup corpus
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q
 
 # The hypothesis fuzz of every config and CSV toolpath at >= 500 cases (see docs/testing.md).
@@ -25,7 +37,7 @@ test-slow: setup
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m slow
 
 # Plausible bugs applied one at a time in a temporary copy; every one must make a test fail.
-mutate: setup
+mutate: setup corpus
 	$(BIN)/python tests/mutate.py
 
 # The interactive view in a real browser: Debian's headless Chromium screenshots the first and last frame of

@@ -138,12 +138,13 @@ def run(
 
 @app.command()
 @user_errors
-def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/ and the README).")]):
-    """Validate a config and its toolpath, build the problem and its NLP, and say what a solve would be."""
+def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/ and the README).")],
+          build: Annotated[bool, typer.Option("--build", help="Also build the NLP (and time it).")] = False):
+    """Validate a config and its toolpath, and say what a solve would be (the NLP's size is counted, not built)."""
     from designopt.experiments.check import check_config
 
     cfg = load(config)
-    s = check_config(cfg)
+    s = check_config(cfg, build)
     joints = Table(title=f"{s.name}: {s.structure}, {len(s.design)} design joints, {len(s.moving)} moving, "
                          f"{s.n_fixed} fixed")
     for col in ("joint", "role", "start", "lower", "upper", "unit"):
@@ -154,16 +155,20 @@ def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/
             joints.add_row(j.name, role, start, f"{j.lower:.6g}", f"{j.upper:.6g}",
                            "m" if j.kind == "length" else "rad")
     show(joints)
-    force = "along the tangent (the paper's model)" if s.force_model == "paper" else "at most (milling model)"
+    force = "along the tangent (the paper's model)" if s.force_model == "paper" else "(milling model)"
     rapids = f" ({s.waypoints - s.tracked} on rapids, untracked)" if s.tracked < s.waypoints else ""
     duration = f", {s.duration:.4g} s" if s.time_unit == "s" else ""
-    out.print(f"toolpath: {s.toolpath_kind}, {s.waypoints} waypoints{rapids}, {s.path_length_m:.6g} m long{duration}, "
-              f"force {s.force_n:.6g} N {force}")
+    ex, ey, ez = (v * 1e3 for v in s.extent_m)
+    out.print(f"toolpath: {s.toolpath_kind}, {s.waypoints} waypoints{rapids}{duration}; {s.path_length_m:.6g} m long: "
+              f"cutting {s.cut_length_m:.6g} m, rapids {s.rapid_length_m:.6g} m; extent {ex:.4g} x {ey:.4g} x "
+              f"{ez:.4g} mm, cuts at z = {s.z_range_m[0] * 1e3:.4g} .. {s.z_range_m[1] * 1e3:.4g} mm in W; force "
+              f"{s.force_range_n[0]:.6g} .. {s.force_range_n[1]:.6g} N {force}")
     if s.cell:
         out.print(f"cell: {s.cell}")
     out.print(f"stiffness: {s.stiffness.describe()}; deflection: {s.deflection}")
+    built = f"built in {s.build_time_s:.2f} s" if s.build_time_s is not None else "counted (--build builds it)"
     out.print(f"NLP (TO, {s.tracking} tracking, {s.kinematics} kinematics): {s.n_variables} variables, "
-              f"{s.n_constraints} constraints; built in {s.build_time_s:.2f} s")
+              f"{s.n_constraints} constraints; {built}")
     out.print(f"a run searches it by {s.search}; nothing was solved")
 
 

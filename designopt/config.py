@@ -14,6 +14,7 @@ A toolpath kind is declared once: a model below with its keys and a ``path(base_
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 from typing import Annotated, Literal, Union
 
@@ -34,8 +35,9 @@ from designopt import toolpaths
 from designopt.clearance import Cell
 from designopt.costs import STIFFNESS_PRESETS
 from designopt.design_space import JointBounds, build_chain, design_joint_names, placement_ets, placement_joints
-from designopt.errors import InputError, read_text
+from designopt.errors import InputError, InputWarning, read_text
 from designopt.forces import MATERIALS, MillingProcess
+from designopt.gcode import WORK_OFFSETS
 from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.joints import DH_PARAMS, Chain, Role
 from designopt.kinematics.presets import PRESETS as DH_PRESETS
@@ -136,21 +138,30 @@ class CsvPath(_Path):
         return toolpaths.from_points(points, self.waypoints, self.alpha)
 
 
+OriginPoint = tuple[float, float, float] | Literal[ORIGINS]
+
+
 class GcodePath(_Path):
     """A G-code program (`designopt.gcode`): cutting moves tracked and loaded, rapids free. ``spacing``: largest
     distance between waypoints along the path (m). ``origin``: where the program's zero lies in W (m), or a named
-    point of the cell's block (W is the block's top-face centre)."""
+    point of the cell's block (W is the block's top-face centre); for a program that uses several work offsets, one
+    per offset: ``{G54: ..., G55: ...}``."""
 
     kind: Literal["gcode"]
     file: str
     spacing: Positive = 2.0e-3
-    origin: tuple[float, float, float] | Literal[ORIGINS] = (0.0, 0.0, 0.0)
+    origin: OriginPoint | dict[Literal[WORK_OFFSETS], OriginPoint] = (0.0, 0.0, 0.0)
+
+    def offsets(self, cell: Cell | None) -> dict[str, np.ndarray]:
+        """Where the zero of each work offset lies in W (m)."""
+        given = self.origin if isinstance(self.origin, dict) else {"G54": self.origin}
+        return {name: program_zero(point, cell) for name, point in given.items()}
 
     def path(self, base_dir, cell):
         from designopt import gcode
 
-        program = gcode.read_program(base_dir / self.file, CHORD_TOLERANCE)
-        sampled = gcode.sample_program(program, self.spacing, RAPID_SPEED, program_zero(self.origin, cell))
+        program = gcode.read_program(base_dir / self.file, CHORD_TOLERANCE, self.offsets(cell))
+        sampled = gcode.sample_program(program, self.spacing, RAPID_SPEED)
         if len(sampled.t) > 5000:
             raise _KeyError("toolpath.spacing", f"{self.spacing:g} m gives {len(sampled.t)} waypoints (at most 5000): "
                                                 "choose a larger spacing")
@@ -536,7 +547,7 @@ def _check_on_block(cfg: Config, cell: Cell | None, toolpath: toolpaths.Toolpath
     """Every cutting waypoint lies over the block's top face (the tool cuts the block, not the air beside it)."""
     if cell is None:
         return
-    (sx, sy, _), (cx, cy) = cell.block_size, cell.block_center
+    (sx, sy, sz), (cx, cy) = cell.block_size, cell.block_center
     xy = toolpath.points_W[toolpath.is_tracked, :2]
     outside = np.flatnonzero((np.abs(xy[:, 0] - cx) > sx / 2 + 1e-9) | (np.abs(xy[:, 1] - cy) > sy / 2 + 1e-9))
     if len(outside):
@@ -545,6 +556,15 @@ def _check_on_block(cfg: Config, cell: Cell | None, toolpath: toolpaths.Toolpath
         raise cfg.error("cell.block", f"{len(outside)} cutting waypoints lie beside the block's top face (the first at "
                                       f"x = {x:.4g}, y = {y:.4g} m in W; the face spans {span}): move the program "
                                       "(toolpath.origin) or grow the block")
+    z = toolpath.points_W[toolpath.is_tracked, 2]
+    hint = "is the program's zero where toolpath.origin says?"
+    if z.min() > 1e-9:
+        warnings.warn(f"{cfg.file}: toolpath: no cutting move reaches into the block: the deepest cut is "
+                      f"{z.min() * 1e3:.4g} mm above the block's top face (z = 0 in W); {hint}", InputWarning,
+                      stacklevel=2)
+    if z.min() < -sz - 1e-9:
+        warnings.warn(f"{cfg.file}: toolpath: cutting moves go {(-sz - z.min()) * 1e3:.4g} mm below the block's "
+                      f"bottom (z = {-sz:g} m in W); {hint}", InputWarning, stacklevel=2)
 
 
 def _key(loc: tuple) -> str:

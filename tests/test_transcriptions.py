@@ -125,3 +125,20 @@ def test_sample_is_the_hermite_trajectory(solved):
     for j in range(Q.shape[1]):
         c = np.linalg.solve(A, [Q[k, j], V[k, j], Q[k + 1, j], V[k + 1, j]])
         assert solved.sample(tp.t[k] + frac * h)[0, j] == pytest.approx(np.polyval(c[::-1], frac * h), abs=1e-12)
+
+
+@pytest.mark.parametrize("config", ["milling.yaml", "gcode_pocket.yaml", "circle_standoff.yaml", "ur10_placement.yaml"])
+def test_the_counted_nlp_size_is_the_built_one(config):
+    """`designopt check` counts the NLP instead of building it: the count must be what a build makes, for every
+    variant of the transcription (soft tracking, differential kinematics, a stand-off, a cell)."""
+    from pathlib import Path
+
+    from designopt.config import load_config
+    from designopt.transcriptions import Collocation
+
+    problem = problem_from_config(load_config(Path(__file__).resolve().parent.parent / "configs" / config))
+    for t in (Collocation(), Collocation(tracking="soft"), Collocation(kinematics="differential", hessian="auto")):
+        if problem.cell is not None and t.kinematics == "differential":
+            continue
+        nlp = t.build(problem).nlp
+        assert t.size(problem) == (nlp.n_variables, nlp.n_constraints), (config, t)

@@ -77,6 +77,23 @@ class Collocation:
     def build(self, problem: DesignProblem) -> CollocationNLP:
         return CollocationNLP(problem, self)
 
+    def size(self, problem: DesignProblem) -> tuple[int, int]:
+        """(variables, constraints) of the NLP `build` would make, counted without building it (a program of
+        thousands of waypoints takes minutes to build and milliseconds to count)."""
+        n_m, n_d, N = problem.chain.n_moving, problem.chain.n_design, problem.toolpath.n
+        differential = self.kinematics == "differential"
+        n_state = 2 * n_m + (3 if differential else 0)
+        n_mid = n_m * (N - 1) if problem.cell is not None else 0
+        per_waypoint = len(tracking_rows(problem, self.tracking, position_in_terms=not differential))
+        per_waypoint += problem.keep_out_radius > 0
+        rows = N * per_waypoint + 2 * n_m * (N - 1)  # per waypoint; the joint and velocity bounds at the midpoints
+        if differential:
+            rows += 3 * N + (3 * N if self.tracking == "hard" else 0)  # p_0 = FK(q_0), Simpson steps; P = S
+        if problem.cell is not None:
+            # the midpoints' joints tied to the cubic, one clearance row per configuration, the block's 4 corners
+            rows += n_mid + (2 * N - 1) + 4
+        return n_d + N * n_state + n_mid, rows
+
     def trajectory(self, t, Q, V) -> HermiteCubic:
         """The joint trajectory the knots (q_k, v_k) define."""
         return HermiteCubic(np.asarray(t, float), np.asarray(Q, float), np.asarray(V, float))
