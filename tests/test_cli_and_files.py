@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -126,3 +127,30 @@ def test_the_solution_set_is_an_output(finished_run):
         seeds = [int(x) for x in str(row["seeds"]).split()]
         assert row["full_path_cost"] == pytest.approx(min(refined[s] for s in seeds if s in refined.index), rel=1e-9)
     assert (run / "figures" / "search_progress.png").stat().st_size > 1000
+
+
+def test_verify_prints_reported_and_recomputed_and_exits_by_verdict(tmp_path):
+    """`python -m designopt.verify` on a good and a tampered file: a row each with reported / recomputed numbers,
+    the tampered one named on stderr, exit 2; the good one alone exits 0; --help exits 0 and names the exit codes."""
+    import subprocess
+    import sys
+
+    good = Path(__file__).parent.parent / "benchmarks" / "reference" / "milling_best_known.json"
+    data = json.loads(good.read_text())
+    data["metrics"]["design_cost"] *= 2
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    run = lambda *a: subprocess.run([sys.executable, "-m", "designopt.verify", *map(str, a)],  # noqa: E731
+                                    capture_output=True, text=True)
+    both = run(good, bad)
+    assert both.returncode == 2, both.stderr
+    rows = both.stdout.strip().splitlines()
+    assert len(rows) == 3 and rows[1].startswith(str(good)) and rows[1].endswith("| ok")
+    assert rows[2].startswith(str(bad)) and rows[2].endswith("DOES NOT CHECK OUT")
+    reported, recomputed = (float(x) for x in rows[2].split(" | ")[1].split(" / "))
+    assert reported == pytest.approx(2 * recomputed, rel=1e-5)
+    errors = both.stderr.strip().splitlines()
+    assert len(errors) == 1 and errors[0].startswith(f"{bad}: ") and "design_cost" in errors[0]
+    assert run(good).returncode == 0
+    helped = run("--help")
+    assert helped.returncode == 0 and "exit codes" in helped.stdout
