@@ -43,6 +43,7 @@ from designopt.kinematics.joints import DH_PARAMS, Chain, Role
 from designopt.kinematics.presets import PRESETS as DH_PRESETS
 from designopt.kinematics.presets import preset as dh_preset
 
+DEFAULT_JOINT_VELOCITY = 10.0  # |dq/dt| bound per unit of the toolpath's time when nothing else gives one
 
 class ConfigError(InputError):
     """A config problem, worded as one line naming the file, the key and the reason."""
@@ -217,7 +218,9 @@ class RobotConfig(_Strict):
     bounds: BoundsConfig = BoundsConfig()
     # one value (both types), {revolute, prismatic}, one value per moving joint, or a preset name
     stiffness: Positive | StiffnessConfig | list[Positive] | str = 1.0
-    joint_velocity: Positive = 10.0
+    # |dq/dt| bound per unit of the toolpath's time: one value or one per moving joint; unset: a URDF robot on a
+    # toolpath timed in seconds takes its URDF's velocity limits, everything else 10
+    joint_velocity: Positive | list[Positive] | None = None
 
     @property
     def is_urdf(self) -> bool:
@@ -396,6 +399,7 @@ class Config(_Strict):
     _chain: Chain | None = PrivateAttr(None)
     _toolpath: toolpaths.Toolpath | None = PrivateAttr(None)
     _cell: Cell | None = PrivateAttr(None)
+    _joint_velocity: float | tuple[float, ...] = PrivateAttr(DEFAULT_JOINT_VELOCITY)
 
     def __eq__(self, other) -> bool:
         """Two configs are equal when their keys are (what validation built from them follows from the keys)."""
@@ -425,10 +429,29 @@ class Config(_Strict):
         self._chain = self._robot_chain()
         self._cell = _cell_of(self, self._chain)
         self._toolpath = self._toolpath_built()
+        self._joint_velocity = self._velocity_limits()
         _check_start_values(self, self._chain)
         _check_standoff(self, self._chain, self._toolpath)
         _check_on_block(self, self._cell, self._toolpath)
         return self
+
+    def _velocity_limits(self) -> float | tuple[float, ...]:
+        """robot.joint_velocity as given; unset, the URDF's limits when the toolpath's time is in seconds (a
+        joint without one takes the default), else DEFAULT_JOINT_VELOCITY."""
+        r, n = self.robot, self._chain.n_moving
+        if isinstance(r.joint_velocity, list):
+            if len(r.joint_velocity) != n:
+                raise self.error("robot.joint_velocity", f"{len(r.joint_velocity)} values for {n} moving joints: give "
+                                                         "one value, or one per moving joint")
+            return tuple(float(v) for v in r.joint_velocity)
+        if r.joint_velocity is not None:
+            return float(r.joint_velocity)
+        if r.is_urdf and self._toolpath.time_unit == "s":
+            from designopt.kinematics.urdf import joint_velocities
+
+            return tuple(DEFAULT_JOINT_VELOCITY if v is None else v
+                         for v in joint_velocities(self._base_dir / r.urdf, r.tool_link))
+        return DEFAULT_JOINT_VELOCITY
 
     def _robot_chain(self) -> Chain:
         r, p = self.robot, self.placement

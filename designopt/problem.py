@@ -35,8 +35,9 @@ class DesignProblem:
     terms in ``waypoint_costs`` and ``design_costs`` (see `designopt.costs`), plus the trajectory
     regularisers ``smoothness`` (weight of the integral of |q''|^2) and ``joint_regularization`` (weight of
     sum_k dt |q_k|^2), plus ``tracking_weight`` * L_t when tracking is soft. ``joint_velocity`` bounds
-    |dq/dt| per unit task time; ``position_tol`` (m) and ``axis_tol`` (norm of z - z*) define when a
-    solution tracks.
+    |dq/dt| per unit of the toolpath's time (one value, or one per moving joint; rad or m per second when the
+    toolpath's time is in seconds, see `velocity_limits`); ``position_tol`` (m) and ``axis_tol`` (norm of
+    z - z*) define when a solution tracks.
     """
 
     name: str
@@ -49,11 +50,16 @@ class DesignProblem:
     tracking_weight: float = 1.0e4
     smoothness: float = 1.0e-9
     joint_regularization: float = 1.0e-7
-    joint_velocity: float = 10.0
+    joint_velocity: float | tuple[float, ...] = 10.0
     keep_out_radius: float = 0.0
     position_tol: float = 1.0e-3
     axis_tol: float = 1.0e-2
     cell: Cell | None = None  # block, floor and capsules: clearance constraints (designopt.clearance)
+
+    @property
+    def velocity_limits(self) -> np.ndarray:
+        """|dq/dt| bound of each moving joint, base to tool (per unit of the toolpath's time)."""
+        return np.broadcast_to(np.asarray(self.joint_velocity, dtype=float), (self.chain.n_moving,)).copy()
 
     @property
     def k_inv(self) -> np.ndarray:
@@ -111,7 +117,7 @@ def problem_from_config(cfg: Config) -> DesignProblem:
         deflection=cfg.costs.deflection,
         waypoint_costs=(WaypointCost("deformation", cfg.costs.deformation_weight, deformation_term),),
         design_costs=(DesignCost("regularization", cfg.costs.regularization, regularization_term, quadratic=True),),
-        joint_velocity=cfg.robot.joint_velocity,
+        joint_velocity=cfg._joint_velocity,
         keep_out_radius=cfg.placement.keep_out_radius,
         position_tol=cfg.tolerance.position,
         axis_tol=cfg.tolerance.axis,

@@ -83,7 +83,8 @@ class Solution:
                                 stiffness=_stiffness_from_file(data),
                                 deflection=m["deflection"],
                                 position_tol=tol.get("position", 1e-3), axis_tol=tol.get("axis", 1e-2),
-                                joint_velocity=float(limits[0].get("velocity_per_task_time", 10.0)),
+                                joint_velocity=tuple(float(lim.get("velocity_per_task_time", 10.0)) for lim in limits)
+                                if data.get("joint_limits") else 10.0,
                                 cell=cell_from_dict(data["cell"]) if "cell" in data else None)
         problem = _with_file_weights(problem, m.get("cost_weights") or {})
         raw = _raw_from_file(data, chain.design_values, t)
@@ -213,8 +214,9 @@ def to_dict(sol: Solution) -> dict:
         # kind they define the trajectory between waypoints
         **({"v": np.asarray(r.V).tolist()} if r.V is not None else {}),
         "trajectory": r.trajectory.kind,
-        "joint_limits": [{"name": j.name, "lower": j.lower, "upper": j.upper, "velocity_per_task_time":
-                          p.joint_velocity} for j in p.chain.moving],
+        # velocity_per_task_time: |dq/dt| per unit of the toolpath's time (per second when time_unit is s)
+        "joint_limits": [{"name": j.name, "lower": j.lower, "upper": j.upper, "velocity_per_task_time": float(v)}
+                         for j, v in zip(p.chain.moving, p.velocity_limits, strict=True)],
         "design_joints": {j.name: float(v) for j, v in zip(p.chain.design, r.q_d, strict=True)},
         "metrics": {
             "design_cost": m.design_cost,

@@ -15,6 +15,7 @@ from typer.testing import CliRunner
 from cli.main import app
 from designopt.config import parse_config
 from designopt.costs import design_length_indices
+from designopt.errors import InputError
 from designopt.kinematics.chain import geometric_jacobian, tool_pose
 from designopt.problem import problem_from_config
 from designopt.verify import verify_file
@@ -164,3 +165,50 @@ def test_joints_without_limits_take_the_default_travel(tmp_path):
         pin.framesForwardKinematics(model, data, q_pin)
         np.testing.assert_allclose(tool_pose(chain, q_ours, chain.design_values),
                                    data.oMf[model.getFrameId("tip")].homogeneous, atol=1e-9)
+
+
+def _urdf_on_pocket(robot: dict):
+    """configs/gcode_pocket.yaml (a program timed in seconds by its feeds) with the UR10 from its URDF."""
+    data = yaml.safe_load((ROOT / "configs" / "gcode_pocket.yaml").read_text())
+    data["robot"] = {"urdf": "robots/ur10.urdf", "tool_link": "tool0", **robot}
+    return parse_config(data, "pocket.yaml", ROOT / "configs")
+
+
+def test_velocity_limits_come_from_the_urdf_on_a_timed_program():
+    """On a toolpath timed in seconds, the moving joints' |dq/dt| bounds are the URDF's <limit velocity>, read here
+    with ElementTree; robot.joint_velocity (one value or one per joint) overrides them; on a task-time path
+    (normalised t, where rad/s mean nothing) the default stays."""
+    import xml.etree.ElementTree as ET
+
+    tree = ET.parse(UR10)
+    moving = [j for j in tree.getroot().iter("joint") if j.get("type") in ("revolute", "continuous", "prismatic")]
+    expected = [float(j.find("limit").get("velocity")) for j in moving]
+    cfg = _urdf_on_pocket({})
+    assert cfg._toolpath.time_unit == "s"
+    problem = problem_from_config(cfg)
+    np.testing.assert_array_equal(problem.velocity_limits, expected)
+    assert len(set(expected)) > 1  # the file's joints differ: a single value could not pass
+    np.testing.assert_array_equal(problem_from_config(_urdf_on_pocket({"joint_velocity": 1.5})).velocity_limits,
+                                  [1.5] * 6)
+    per_joint = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+    assert problem_from_config(_urdf_on_pocket({"joint_velocity": per_joint})).velocity_limits.tolist() == per_joint
+    with pytest.raises(InputError, match=r"robot\.joint_velocity.*3 values for 6 moving joints"):
+        _urdf_on_pocket({"joint_velocity": [1.0, 2.0, 3.0]})
+    task_time = urdf_problem(UR10, "tool0")
+    assert task_time.toolpath.time_unit == "task"
+    np.testing.assert_array_equal(task_time.velocity_limits, [10.0] * 6)
+
+
+def test_a_mimic_joint_on_the_chain_is_refused(tmp_path):
+    """A coupled joint (a finger that mimics another) cannot be an independent joint of the chain: one line that
+    names it and says to choose a tool link above it."""
+    text = OFFAXIS.read_text().replace('<joint name="j3" type="revolute">\n    <parent link="l3"/><child link="l4"/>',
+                                       '<joint name="j3" type="revolute">\n    <parent link="l3"/><child link="l4"/>\n'
+                                       '    <mimic joint="j1" multiplier="-1"/>')
+    assert "<mimic" in text
+    path = tmp_path / "mimic.urdf"
+    path.write_text(text)
+    with pytest.raises(InputError, match=r"robot\.tool_link: .*'j3'.*mimics 'j1'.*above it") as info:
+        urdf_problem(path, "tip")
+    assert "\n" not in str(info.value)
+    assert urdf_problem(path, "l3").chain.n_moving == 2  # a tool link above the finger is fine

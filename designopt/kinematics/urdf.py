@@ -89,6 +89,10 @@ def chain_from_urdf(path: Path, tool_link: str, placement: list[Joint], placemen
             robot.append(ET(motion, axis, len(joints)))
             joints.append(Joint(name, "length" if length else "angle", Role.FIXED, float(values[component]), lo, hi,
                                 tags))
+        if uj.type in MOVING_TYPES and uj.mimic is not None:
+            raise config_error("robot.tool_link", f"the chain to {tool_link!r} passes joint {uj.name!r}, which mimics "
+                                                  f"{uj.mimic.joint!r} (a finger or coupled joint): choose a tool_link "
+                                                  "above it, e.g. the hand or flange link")
         if uj.type in MOVING_TYPES:
             motion = MOVING_TYPES[uj.type]
             axis = np.asarray(uj.axis if uj.axis is not None else (1.0, 0.0, 0.0), dtype=float)
@@ -104,3 +108,15 @@ def chain_from_urdf(path: Path, tool_link: str, placement: list[Joint], placemen
                                                  "prismatic and fixed joints make a serial chain")
         frames.append(len(robot))
     return Chain(joints=tuple(joints), placement=placement_ets, robot=tuple(robot), frames=tuple(frames))
+
+
+def joint_velocities(path: Path, tool_link: str) -> tuple[float | None, ...]:
+    """The URDF's velocity limit of each moving joint on the chain to ``tool_link`` (rad/s or m/s; None where
+    the file gives none or 0)."""
+    urdf = load_urdf(path)
+
+    def config_error(key, reason):
+        return InputError(path, key, reason)
+
+    return tuple(float(uj.limit.velocity) if uj.limit is not None and uj.limit.velocity else None
+                 for uj in serial_joints(urdf, tool_link, config_error) if uj.type in MOVING_TYPES)

@@ -164,7 +164,7 @@ class CollocationNLP:
 
         lo_m = np.array([j.lower for j in chain.moving])
         hi_m = np.array([j.upper for j in chain.moving])
-        vmax = problem.joint_velocity
+        vmax = np.tile(problem.velocity_limits[:, None], (1, N - 1))
         cons.add(Q_mid, np.tile(lo_m[:, None], (1, N - 1)), np.tile(hi_m[:, None], (1, N - 1)))
         cons.add(V_mid, -vmax, vmax)
         cell_blocks = []
@@ -185,8 +185,8 @@ class CollocationNLP:
                                               first + np.arange(floor.size1_out(1))[None, :], ()))
 
         n_free = self.n_state - 2 * n_m
-        state_lo = np.concatenate([lo_m, -vmax * np.ones(n_m), -np.inf * np.ones(n_free)])
-        state_hi = np.concatenate([hi_m, vmax * np.ones(n_m), np.inf * np.ones(n_free)])
+        state_lo = np.concatenate([lo_m, -problem.velocity_limits, -np.inf * np.ones(n_free)])
+        state_hi = np.concatenate([hi_m, problem.velocity_limits, np.inf * np.ones(n_free)])
         mid_lo, mid_hi = np.tile(lo_m, N - 1)[: self.n_mid], np.tile(hi_m, N - 1)[: self.n_mid]
         lbx = np.concatenate([[j.lower for j in chain.design], np.tile(state_lo, N), mid_lo])
         ubx = np.concatenate([[j.upper for j in chain.design], np.tile(state_hi, N), mid_hi])
@@ -204,7 +204,7 @@ class CollocationNLP:
         p = self.problem
         Q = np.asarray(guess.Q, dtype=float)
         V = np.gradient(Q, p.toolpath.t, axis=0) if guess.V is None else np.asarray(guess.V, dtype=float)
-        V = np.clip(V, -p.joint_velocity, p.joint_velocity)
+        V = np.clip(V, -p.velocity_limits, p.velocity_limits)
         blocks = [Q, V]
         if self.scheme.kinematics == "differential":
             blocks.append(np.asarray(p.toolpath.points_W))
