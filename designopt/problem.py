@@ -25,6 +25,7 @@ from designopt.costs import (
     waypoint,
 )
 from designopt.kinematics.joints import Chain
+from designopt.kinematics.urdf import RobotFile
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,7 @@ class DesignProblem:
     position_tol: float = 1.0e-3
     axis_tol: float = 1.0e-2
     cell: Cell | None = None  # block, floor and capsules: clearance constraints (designopt.clearance)
+    robot_file: RobotFile | None = None  # the URDF the chain was read from (export keeps its names and meshes)
 
     @property
     def velocity_limits(self) -> np.ndarray:
@@ -122,4 +124,6 @@ def problem_from_config(cfg: Config) -> DesignProblem:
         position_tol=cfg.tolerance.position,
         axis_tol=cfg.tolerance.axis,
         cell=cell,
+        robot_file=RobotFile(str((cfg.base_dir / cfg.robot.urdf).resolve()), cfg.robot.tool_link)
+        if cfg.robot.is_urdf else None,
     )

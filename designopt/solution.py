@@ -20,6 +20,7 @@ from designopt.clearance import Cell
 from designopt.costs import Stiffness
 from designopt.evaluation import Metrics, evaluate
 from designopt.kinematics.joints import DH_PARAMS, Chain, Role
+from designopt.kinematics.urdf import RobotFile
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import RawResult
 from designopt.transcriptions.trajectory import trajectory as make_trajectory
@@ -85,7 +86,9 @@ class Solution:
                                 position_tol=tol.get("position", 1e-3), axis_tol=tol.get("axis", 1e-2),
                                 joint_velocity=tuple(float(lim.get("velocity_per_task_time", 10.0)) for lim in limits)
                                 if data.get("joint_limits") else 10.0,
-                                cell=cell_from_dict(data["cell"]) if "cell" in data else None)
+                                cell=cell_from_dict(data["cell"]) if "cell" in data else None,
+                                robot_file=RobotFile(str(data["urdf"]["file"]), str(data["urdf"]["tool_link"]))
+                                if isinstance(data.get("urdf"), dict) else None)
         problem = _with_file_weights(problem, m.get("cost_weights") or {})
         raw = _raw_from_file(data, chain.design_values, t)
         return cls(problem, data.get("method", "file"), raw, evaluate(problem, raw.q_d, raw.trajectory))
@@ -209,6 +212,7 @@ def to_dict(sol: Solution) -> dict:
             **({"tracked": p.toolpath.is_tracked.tolist()} if p.toolpath.tracked is not None else {}),
         },
         **({"cell": cell_to_dict(p.cell)} if p.cell is not None else {}),
+        **({"urdf": {"file": p.robot_file.path, "tool_link": p.robot_file.tool_link}} if p.robot_file else {}),
         "q": np.asarray(r.Q).tolist(),
         # joint velocities dq/dt at the waypoints (TO's Hermite knots; absent for FK): with q and the trajectory's
         # kind they define the trajectory between waypoints

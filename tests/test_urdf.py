@@ -18,6 +18,7 @@ from designopt.costs import design_length_indices
 from designopt.errors import InputError
 from designopt.kinematics.chain import geometric_jacobian, tool_pose
 from designopt.problem import problem_from_config
+from designopt.solution import chain_from_file
 from designopt.verify import verify_file
 
 pin = pytest.importorskip("pinocchio")
@@ -116,10 +117,14 @@ def test_ur10_placement_runs_tracks_and_reverifies(tmp_path):
     assert best["metrics"]["tracks"] and "ets" in best and "dh" not in best
     for f in [run / "best.json", *(run / "solutions").glob("*.json")]:
         assert verify_file(f) == [], f
-    # the exported cell loads in pinocchio with the solved tool pose at every waypoint
+    # the exported cell is the UR10's own URDF (its joint names) and loads in pinocchio with designopt's tool pose
+    # (1e-9) and the solved tool position at every waypoint
     model = pin.buildModelFromUrdf(str(run / "export" / "best.urdf"))
+    assert list(model.names)[1:] == list(pin.buildModelFromUrdf(str(UR10)).names)[1:] == [
+        "shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
     data = model.createData()
-    frame = model.getFrameId("flange")
+    frame = model.getFrameId("designopt_tool")
+    chain = chain_from_file(best)
     placement = best["placement"]
     yaw, pitch, roll = placement["ypr"]
     c, s = math.cos, math.sin
@@ -128,6 +133,7 @@ def test_ur10_placement_runs_tracks_and_reverifies(tmp_path):
             @ np.array([[1, 0, 0], [0, c(roll), -s(roll)], [0, s(roll), c(roll)]]))
     for q, p_W in zip(best["q"], best["toolpath"]["points_W"], strict=True):
         pin.framesForwardKinematics(model, data, np.array(q))
+        np.testing.assert_allclose(data.oMf[frame].homogeneous, tool_pose(chain, np.array(q), np.zeros(0)), atol=1e-9)
         target = R_BW @ np.array(p_W) + np.array(placement["xyz"])
         np.testing.assert_allclose(data.oMf[frame].translation, target, atol=1.1e-3)
 

@@ -11,6 +11,7 @@ with the URDF's limits). The tool frame is ``tool_link``'s frame.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,14 @@ from designopt.kinematics.joints import ET, REGULARISED, Chain, Joint, Role, X, 
 ORIGIN = (("x", "translate", X), ("y", "translate", Y), ("z", "translate", Z),
           ("yaw", "rotate", Z), ("pitch", "rotate", Y), ("roll", "rotate", X))
 MOVING_TYPES = {"revolute": "rotate", "continuous": "rotate", "prismatic": "translate"}
+
+
+@dataclass(frozen=True)
+class RobotFile:
+    """Where a robot came from: its URDF (an absolute path) and the link that carries the tool."""
+
+    path: str
+    tool_link: str
 
 
 def rpy_of(R: np.ndarray) -> tuple[float, float, float]:
