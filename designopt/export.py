@@ -62,7 +62,7 @@ def urdf_model(data: dict, name: str = "designopt_cell", sphere_radius: float = 
         _cell(data, base, parent, links, joints, materials, sphere_radius, prefix="designopt_")
         return y.URDF(robot=y.Robot(name=robot.name, links=links, joints=joints, materials=materials,
                                     transmission=robot.transmission, gazebo=robot.gazebo),
-                      build_scene_graph=True, load_meshes=False)
+                      build_scene_graph=True, load_meshes=False, filename_handler=y.filename_handler_null)
     links = [y.Link(name=BASE, visuals=[y.Visual(geometry=y.Geometry(sphere=y.Sphere(0.03)), material=grey)])]
     joints = []
     parent = BASE
@@ -109,7 +109,8 @@ def _source_robot(data: dict, source: Path):
 
     from designopt.kinematics.urdf import ORIGIN, rpy_of
 
-    robot = y.URDF.load(str(source), build_scene_graph=False, load_meshes=False).robot
+    robot = y.URDF.load(str(source), build_scene_graph=False, load_meshes=False,
+                        filename_handler=y.filename_handler_null).robot  # meshes are referenced, never opened
     by_name = {j.name: j for j in robot.joints}
     for key, value in (data.get("design_joints") or {}).items():
         joint, _, component = key.partition(".origin.")

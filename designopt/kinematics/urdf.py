@@ -66,7 +66,8 @@ def load_urdf(path: Path):
     import yourdfpy
 
     try:
-        return yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False)
+        return yourdfpy.URDF.load(str(path), build_scene_graph=False, load_meshes=False,
+                                  filename_handler=yourdfpy.filename_handler_null)  # meshes: never opened
     except Exception as exc:  # yourdfpy raises what lxml or its own parser raise: all mean "not a URDF"
         reason = str(exc).splitlines()[0] if str(exc) else repr(exc)
         raise InputError(path, "(file)", f"not a readable URDF: {reason}") from None
