@@ -104,10 +104,17 @@ def run(
         result = run_experiment(cfg, out_dir, name, bar, figures=not no_figures, resume=resume, jobs=jobs)
     problem = result.problem
     if result.explored:
-        tracking = sum(s.metrics.tracks for s in result.explored)
-        out.print(f"explored: {len(result.explored)} starts on {result.explored[0].problem.toolpath.n} waypoints, "
-                  f"{tracking} track, {len(result.solution_set)} distinct optima; the best "
-                  f"{len(result.solutions)} refined on the full path ({problem.toolpath.n} waypoints)")
+        stages = {}  # waypoints -> (solves, tracking), in the order the search ran them
+        for sol in result.explored:
+            n, tracks = sol.problem.toolpath.n, int(sol.metrics.tracks)
+            solves, tracking = stages.get(n, (0, 0))
+            stages[n] = (solves + 1, tracking + tracks)
+        parts = [f"{solves} solves on {n} waypoints ({tracking} track)" for n, (solves, tracking) in stages.items()]
+        out.print(f"explored: {', '.join(parts)}; {len(result.solution_set)} distinct optima; "
+                  f"{len(result.solutions)} refined on the full path ({problem.toolpath.n} waypoints)"
+                  + ("" if result.solutions or list(stages.values())[-1][1] else
+                     " -- nothing tracked on the last coarse path, so nothing was refined: try more starts "
+                     "(search.starts) or another start placement"))
     show(solutions_table(result.solutions, f"{cfg.name}: {problem.chain.structure}, "
                                            f"stiffness {problem.stiffness.describe()}"))
     if len(result.solution_set):
