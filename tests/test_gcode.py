@@ -4,6 +4,7 @@ time, rapids untracked and unloaded; bad programs through the CLI are one line a
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -271,3 +272,30 @@ def test_check_warns_when_the_cuts_are_not_in_the_block(tmp_path):
     (tmp_path / "c.yaml").write_text((tmp_path / "c.yaml").read_text().replace("top_corner", "bottom_corner"))
     result = CliRunner().invoke(app, ["check", str(tmp_path / "c.yaml")])
     assert result.exit_code == 0 and "warning:" not in result.output, result.output
+
+
+@pytest.mark.parametrize("depth,warning", [
+    ("Z-1", None),
+    ("Z2", r"no cutting move reaches into the block: the deepest cut is 2 mm above the block's top face"),
+    ("Z-25", r"cutting moves go 5 mm below the block's bottom \(z = -0.02 m in W\)"),
+])
+def test_a_program_above_or_below_the_block_is_warned_about(tmp_path, depth, warning):
+    """The block is 20 mm high with W on its top face: a program that never cuts into it, or cuts through its
+    bottom, is accepted with a warning that names by how much (an ordinary pocket is not warned about)."""
+    import warnings as w
+
+    from designopt.errors import InputWarning
+
+    (tmp_path / "p.nc").write_text(f"G21 G90\nG0 X0 Y0 Z5\nG1 {depth} F300\nG1 X10 F600\n")
+    data = {"toolpath": {"kind": "gcode", "file": "p.nc", "spacing": 0.004}, "design": ["placement"],
+            "placement": {"xyz": [0.45, 0.0, -0.2]},
+            "cell": {"block": [0.04, 0.04, 0.02], "floor": -0.9, "clearance": 0.005, "link_radius": 0.05,
+                     "tool_length": 0.1}}
+    with w.catch_warnings(record=True) as caught:
+        w.simplefilter("always")
+        parse_config(data, tmp_path / "c.yaml", tmp_path)
+    messages = [str(c.message) for c in caught if issubclass(c.category, InputWarning)]
+    if warning is None:
+        assert messages == []
+    else:
+        assert len(messages) == 1 and re.search(warning, messages[0]) and "toolpath.origin" in messages[0], messages
