@@ -104,17 +104,16 @@ def run(
         result = run_experiment(cfg, out_dir, name, bar, figures=not no_figures, resume=resume, jobs=jobs)
     problem = result.problem
     if result.explored:
-        stages = {}  # waypoints -> (solves, tracking), in the order the search ran them
-        for sol in result.explored:
-            n, tracks = sol.problem.toolpath.n, int(sol.metrics.tracks)
-            solves, tracking = stages.get(n, (0, 0))
-            stages[n] = (solves + 1, tracking + tracks)
-        parts = [f"{solves} solves on {n} waypoints ({tracking} track)" for n, (solves, tracking) in stages.items()]
+        # every coarse stage (explore on the coarsest path, screen on a finer one) with how many of its solves track
+        coarse = result.summary[~result.summary["stage"].isin(["refine", "start"])]
+        stages = [(stage, len(rows), int(rows["tracks"].astype(str).str.lower().eq("true").sum()))
+                  for stage, rows in coarse.groupby("stage", sort=False)]
+        parts = [f"{stage} {solves} solves ({tracking} track)" for stage, solves, tracking in stages]
         out.print(f"explored: {', '.join(parts)}; {len(result.solution_set)} distinct optima; "
                   f"{len(result.solutions)} refined on the full path ({problem.toolpath.n} waypoints)"
-                  + ("" if result.solutions or list(stages.values())[-1][1] else
-                     " -- nothing tracked on the last coarse path, so nothing was refined: try more starts "
-                     "(search.starts) or another start placement"))
+                  + ("" if result.solutions or not stages or stages[-1][2] else
+                     f" -- nothing tracked in the {stages[-1][0]} stage, so nothing was refined: try more starts "
+                     "(search.starts), another start placement or search.preset paper (starts on the full path)"))
     show(solutions_table(result.solutions, f"{cfg.name}: {problem.chain.structure}, "
                                            f"stiffness {problem.stiffness.describe()}"))
     if len(result.solution_set):
