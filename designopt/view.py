@@ -125,13 +125,15 @@ def cell_figure(sol: Solution, frames: int = 60) -> go.Figure:
     meshes = [robot_mesh(sol, Q[k], radius) for k in picks]
     robot_index = len(traces)
     traces.append(_mesh_trace(*meshes[0], COLORS["robot"], f"{chain.structure} robot"))
-    traces.append(go.Scatter3d(x=[s_B[picks[0], 0]], y=[s_B[picks[0], 1]], z=[s_B[picks[0], 2]], mode="markers",
+    # the robot's own tool centre point (on the path when the solution tracks; off it, visibly, when not)
+    tcp = np.array([tool_pose(chain, Q[k], np.zeros(0))[:3, 3] for k in picks], dtype=float)
+    traces.append(go.Scatter3d(x=tcp[:1, 0], y=tcp[:1, 1], z=tcp[:1, 2], mode="markers",
                                marker={"size": 6, "color": COLORS["path"]}, name="tool centre point"))
     animation = []
-    for n, (k, (v, t)) in enumerate(zip(picks, meshes, strict=True)):
+    for n, ((v, t), p) in enumerate(zip(meshes, tcp, strict=True)):
         animation.append(go.Frame(name=str(n), traces=[robot_index, robot_index + 1], data=[
             go.Mesh3d(x=v[:, 0], y=v[:, 1], z=v[:, 2], i=t[:, 0], j=t[:, 1], k=t[:, 2]),
-            go.Scatter3d(x=[s_B[k, 0]], y=[s_B[k, 1]], z=[s_B[k, 2]])]))
+            go.Scatter3d(x=[p[0]], y=[p[1]], z=[p[2]])]))
     unit = "s" if tp.time_unit == "s" else ""
     steps = [{"method": "animate", "label": f"{tp.t[k]:.3g}{unit}",
               "args": [[str(n)], {"mode": "immediate", "frame": {"duration": 0, "redraw": True},

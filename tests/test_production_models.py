@@ -21,7 +21,7 @@ from designopt.problem import problem_from_config
 from designopt.solution import Solution, to_dict
 from designopt.solve import SolverProfile, solve_guess
 from designopt.transcriptions import Collocation
-from designopt.verify import _placement, _skeleton
+from designopt.verify import _placement, _robot_walk, _skeleton
 
 ROOT = Path(__file__).resolve().parent.parent
 MM = 1e-3
@@ -110,6 +110,9 @@ def test_the_view_draws_the_solution_where_verify_puts_it(pocket):
     picks = np.unique(np.linspace(0, len(data["q"]) - 1, 3).round().astype(int))
     assert len(fig.frames) == len(picks)
     for frame, k in zip(fig.frames, picks, strict=True):
+        marker = frame.data[1]  # the tool centre point: the robot's, by verify's own forward kinematics
+        tcp = _tool_position(data, np.array(data["q"][k]))
+        np.testing.assert_allclose([marker.x[0], marker.y[0], marker.z[0]], tcp, atol=1e-12)
         mesh = frame.data[0]
         vertices = np.column_stack([mesh.x, mesh.y, mesh.z])
         points, links = _skeleton(data, np.array(data["q"][k]), cell["tool"]["length"])
@@ -118,3 +121,9 @@ def test_the_view_draws_the_solution_where_verify_puts_it(pocket):
             r = radii[min(links[i - 1] if i else 0, len(radii) - 1)]
             on_sphere = np.abs(np.linalg.norm(vertices - np.asarray(p, dtype=float), axis=1) - r) < 1e-9
             assert on_sphere.sum() >= 40, (k, i)  # a whole sphere (8 x 5 vertices) of radius r around the joint
+
+
+def _tool_position(data: dict, q: np.ndarray) -> np.ndarray:
+    """The tool centre point in B by verify's numpy walk of the file: last link frame times the tool."""
+    T, *_ = _robot_walk(data, q)
+    return (T @ np.array(data["tool"], dtype=float))[:3, 3]
