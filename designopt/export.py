@@ -55,11 +55,13 @@ def urdf_model(data: dict, name: str = "designopt_cell", sphere_radius: float = 
     grey = y.Material(name="link", color=y.Color(rgba=np.array([0.3, 0.45, 0.7, 1.0])))
     source = source_urdf(data)
     if source is not None:
-        robot = _source_robot(data, source)
+        from designopt.kinematics.urdf import root_link
+
+        source_model = _source_model(data, source)
+        robot = source_model.robot
         links, joints, materials = robot.links, robot.joints, robot.materials
-        root = {link.name for link in links} - {j.child for j in joints}
-        base, parent = sorted(root)[0], data["urdf"]["tool_link"]
-        _cell(data, base, parent, links, joints, materials, sphere_radius, prefix="designopt_")
+        _cell(data, root_link(source_model), data["urdf"]["tool_link"], links, joints, materials, sphere_radius,
+              prefix="designopt_")
         return y.URDF(robot=y.Robot(name=robot.name, links=links, joints=joints, materials=materials,
                                     transmission=robot.transmission, gazebo=robot.gazebo),
                       build_scene_graph=True, load_meshes=False, filename_handler=y.filename_handler_null)
@@ -103,14 +105,12 @@ def urdf_model(data: dict, name: str = "designopt_cell", sphere_radius: float = 
                   build_scene_graph=True, load_meshes=False)
 
 
-def _source_robot(data: dict, source: Path):
-    """The robot of the source URDF with the solution's origin values and absolute relative mesh paths."""
-    import yourdfpy as y
+def _source_model(data: dict, source: Path):
+    """The source URDF with the solution's origin values and absolute relative mesh paths."""
+    from designopt.kinematics.urdf import ORIGIN, load_urdf, rpy_of
 
-    from designopt.kinematics.urdf import ORIGIN, rpy_of
-
-    robot = y.URDF.load(str(source), build_scene_graph=False, load_meshes=False,
-                        filename_handler=y.filename_handler_null).robot  # meshes are referenced, never opened
+    model = load_urdf(source)
+    robot = model.robot
     by_name = {j.name: j for j in robot.joints}
     for key, value in (data.get("design_joints") or {}).items():
         joint, _, component = key.partition(".origin.")
@@ -127,7 +127,7 @@ def _source_robot(data: dict, source: Path):
             mesh = shape.geometry.mesh if shape.geometry is not None else None
             if mesh is not None and "://" not in mesh.filename and not Path(mesh.filename).is_absolute():
                 mesh.filename = str((source.parent / mesh.filename).resolve())
-    return robot
+    return model
 
 
 def _cell(data: dict, base: str, flange: str, links: list, joints: list, materials: list, sphere_radius: float,
