@@ -15,25 +15,21 @@ import argparse
 import os
 import statistics
 import tempfile
-import time
-from dataclasses import replace
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import casadi as ca  # noqa: E402
-from iteration_split import corrected_share  # noqa: E402
+from iteration_split import logged_solve  # noqa: E402
 
 import designopt.transcriptions.nlp as nlp_module  # noqa: E402
 from designopt.config import load_config  # noqa: E402
 from designopt.costs import deflection  # noqa: E402
 from designopt.evaluation import evaluate  # noqa: E402
 from designopt.experiments.adapters import search_from_config  # noqa: E402
-from designopt.initial_guess import initial_guess  # noqa: E402
 from designopt.problem import problem_from_config  # noqa: E402
 from designopt.solve import local  # noqa: E402
-from designopt.transcriptions import Collocation  # noqa: E402
 from designopt.transcriptions.compiled import compiled  # noqa: E402
 
 EXACT = nlp_module.block_hessian_function
@@ -67,18 +63,11 @@ def gauss_newton_blocks(problem):
 def run(problem, search, starts, tmp, label):
     rows = []
     for start in range(starts):
-        log = Path(tmp) / f"{label}{start}.log"
-        profile = replace(search.profile, options=(("ipopt.output_file", str(log)), ("ipopt.file_print_level", 5)))
-        built, solver, _ = local.prepared(problem, Collocation(), profile)
-        guess = initial_guess(problem, start, search.seed, search.perturbation, search.init)
-        cpu = time.process_time()
-        outcome = solver.solve(built.pack(guess))
-        total = time.process_time() - cpu
+        built, _, outcome, total, corrected, _ = logged_solve(problem, search, start, Path(tmp) / f"{label}{start}.log")
         q_d, trajectory, _ = built.unpack(outcome.x)
         metrics = evaluate(problem, q_d, trajectory)
-        corrected, counted = corrected_share(log.read_text())
-        rows.append((outcome.status, outcome.iterations, 1e3 * total / max(outcome.iterations, 1),
-                     corrected / max(counted, 1), metrics.design_cost, metrics.tracks))
+        rows.append((outcome.status, outcome.iterations, 1e3 * total / max(outcome.iterations, 1), corrected,
+                     metrics.design_cost, metrics.tracks))
     return rows
 
 

@@ -29,7 +29,7 @@ from designopt.config import load_config  # noqa: E402
 from designopt.experiments.adapters import search_from_config  # noqa: E402
 from designopt.initial_guess import initial_guess  # noqa: E402
 from designopt.problem import problem_from_config  # noqa: E402
-from designopt.solve.local import prepared  # noqa: E402
+from designopt.solve import local  # noqa: E402
 from designopt.solve.strategies.coarse_to_fine import coarse_problem  # noqa: E402
 from designopt.transcriptions import Collocation  # noqa: E402
 
@@ -41,6 +41,19 @@ def corrected_share(log: str) -> tuple[int, int]:
     """(iterations with an inertia correction, iterations) from an IPOPT log at print level 5."""
     rows = [m for line in log.splitlines() if (m := ITERATION.match(line))]
     return sum(1 for m in rows if m.group(2) != "-"), len(rows)
+
+
+def logged_solve(problem, search, start: int, log: Path):
+    """Solve seeded start ``start`` with IPOPT logging to ``log``: (built NLP, prepared solver, outcome, CPU
+    seconds of the solve, share of inertia-corrected iterations, seconds spent building and preparing)."""
+    profile = replace(search.profile, options=(("ipopt.output_file", str(log)), ("ipopt.file_print_level", 5)))
+    built, solver, build_s = local.prepared(problem, Collocation(), profile)
+    guess = initial_guess(problem, start, search.seed, search.perturbation, search.init)
+    cpu = time.process_time()
+    outcome = solver.solve(built.pack(guess))
+    total = time.process_time() - cpu
+    corrected, counted = corrected_share(log.read_text())
+    return built, solver, outcome, total, corrected / max(counted, 1), build_s
 
 
 def main() -> None:
@@ -57,21 +70,14 @@ def main() -> None:
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for start in range(args.starts):
-            log = Path(tmp) / f"ipopt{start}.log"
-            profile = replace(search.profile, options=(("ipopt.output_file", str(log)),
-                                                       ("ipopt.file_print_level", 5)))
-            built, solver, build_s = prepared(problem, Collocation(), profile)
-            guess = initial_guess(problem, start, search.seed, search.perturbation, search.init)
-            cpu = time.process_time()
-            outcome = solver.solve(built.pack(guess))
-            total = time.process_time() - cpu
+            _, solver, outcome, total, corrected, build_s = logged_solve(problem, search, start,
+                                                                         Path(tmp) / f"ipopt{start}.log")
             stats = solver.solver.stats()
             functions = sum(stats.get(f"t_proc_{name}", 0.0) for name in FUNCTIONS)
-            corrected, counted = corrected_share(log.read_text())
             n = max(outcome.iterations, 1)
             rows.append((start, outcome.status, outcome.iterations, 1e3 * total / n, 1e3 * functions / n,
                          1e3 * stats.get("t_proc_nlp_hess_l", 0.0) / n, 1e3 * (total - functions) / n,
-                         corrected / max(counted, 1), build_s))
+                         corrected, build_s))
     nlp = solver.nlp
     print(f"{args.config} ({problem.toolpath.n} waypoints, {nlp.n_variables} variables, {nlp.n_constraints} rows)")
     print("start | status | iterations | ms/iter | functions | of which Hessian | rest (linear solves, ...) | "
