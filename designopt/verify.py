@@ -363,7 +363,13 @@ def _check_cell(data: dict, n: int, file) -> None:
 
 def problems(data: dict, rtol: float = 1e-6) -> list[tuple[str, str]]:
     """(key, reason) for every reported number that does not follow from the file's own data."""
-    found = []
+    return audit(data, rtol)[2]
+
+
+def audit(data: dict, rtol: float = 1e-6) -> tuple[Check, tuple[float, int, str] | None, list[tuple[str, str]]]:
+    """The recomputation of a file (`recompute`, and `clearance` when it has a cell, else None) and its
+    `problems`."""
+    found, swept = [], None
     m = data["metrics"]
     alpha = float(data["force_alpha"])
     norms = np.linalg.norm(np.array(data["toolpath"]["force_W"], dtype=float), axis=1)
@@ -384,11 +390,11 @@ def problems(data: dict, rtol: float = 1e-6) -> list[tuple[str, str]]:
         found.append(("metrics.tracks", f"{m['tracks']} != recomputed {check.tracks}"))
     if "cell" in data:
         reported = m.get("clearance", {}).get("min")
-        value, link, what = clearance(data)
+        swept = value, link, what = clearance(data)
         if reported is None or not np.isclose(value, reported, rtol=0.0, atol=1e-6):
             found.append(("metrics.clearance.min", f"{reported} != {value:.9g} recomputed with coal ({what}, link "
                                                    f"{link})"))
-    return found
+    return check, swept, found
 
 
 def verify_file(path: Path, rtol: float = 1e-6) -> list[str]:
@@ -418,13 +424,13 @@ exit codes: 0 every file checks out; 2 a file is malformed, unreadable, or repor
 from its data (the problem is named on stderr, one line per file)."""
 
 
-def _row(path, data: dict) -> str:
-    m, check = data["metrics"], recompute(data)
+def _row(path, data: dict, check: Check, swept: tuple[float, int, str] | None) -> str:
+    m = data["metrics"]
     cells = [str(path), f"{m['design_cost']:.6g} / {check.design_cost:.6g}",
              f"{m['max_position_error']:.3g} / {check.max_position_error:.3g}",
              f"{m['max_axis_error']:.3g} / {check.max_axis_error:.3g}", f"{m['tracks']} / {check.tracks}"]
-    if "cell" in data:
-        value, link, what = clearance(data)
+    if swept is not None:
+        value, link, what = swept
         cells.append(f"{m.get('clearance', {}).get('min', float('nan')):.4g} / {value:.4g} ({what}, link {link})")
     else:
         cells.append("-")
@@ -443,9 +449,9 @@ def main(argv: list[str]) -> int:
     for arg in argv:
         try:
             data = read_solution(arg)
-            found = problems(data)
+            check, swept, found = audit(data)
             try:
-                row = _row(arg, data)
+                row = _row(arg, data, check, swept)
             except (ArithmeticError, LookupError, TypeError, ValueError):  # a tampered file: its problem says why
                 row = f"{arg} | ? | ? | ? | ? | ?"
             print(f"{row} | {'ok' if not found else 'DOES NOT CHECK OUT'}", flush=True)
