@@ -46,7 +46,8 @@ def corrected_share(log: str) -> tuple[int, int]:
 def logged_solve(problem, search, start: int, log: Path):
     """Solve seeded start ``start`` with IPOPT logging to ``log``: (built NLP, prepared solver, outcome, CPU
     seconds of the solve, share of inertia-corrected iterations, seconds spent building and preparing)."""
-    profile = replace(search.profile, options=(("ipopt.output_file", str(log)), ("ipopt.file_print_level", 5)))
+    profile = replace(search.profile, options=(*search.profile.options, ("ipopt.output_file", str(log)),
+                                               ("ipopt.file_print_level", 5)))
     built, solver, build_s = local.prepared(problem, Collocation(), profile)
     guess = initial_guess(problem, start, search.seed, search.perturbation, search.init)
     cpu = time.process_time()

@@ -43,13 +43,16 @@ def test_a_failed_solve_is_a_result(method, gantry_problem):
 
 
 @pytest.mark.parametrize("method", METHODS)
-def test_structured_hessian_equals_casadi(method, rng):
+def test_structured_derivatives_equal_casadi(method, rng):
+    """The Hessian, constraint Jacobian and gradient assembled from per-waypoint blocks equal the ones CasADi
+    derives from the whole graph (the ``auto`` transcription)."""
     cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 6},
            "robot": {"structure": "RPRR", "dh": "generic", "stiffness": {"revolute": 2.0, "prismatic": 0.5}},
            "placement": {"xyz": [0.4, 0.1, 0.0], "keep_out_radius": 0.1}}
     problem = problem_from_config(parse_config(cfg))
     _, ours, _ = prepared(problem, transcription_named(method, hessian="structured"), SolverProfile(compile="none"))
     _, ref, _ = prepared(problem, transcription_named(method, hessian="auto"), SolverProfile())
+    ours_solver, ref_solver = ours.solver, ref.solver
     ours, ref, H_ours, H_ref = (ours.nlp, ref.nlp, ours.solver.get_function("nlp_hess_l"),
                                 ref.solver.get_function("nlp_hess_l"))
     assert (ours.n_variables, ours.n_constraints) == (ref.n_variables, ref.n_constraints)
@@ -57,6 +60,9 @@ def test_structured_hessian_equals_casadi(method, rng):
         x, lam_g = rng.normal(size=ours.n_variables), rng.normal(size=ours.n_constraints)
         np.testing.assert_allclose(np.triu(np.array(ca.DM(H_ours(x, [], 0.7, lam_g)))),
                                    np.triu(np.array(ca.DM(H_ref(x, [], 0.7, lam_g)))), rtol=1e-9, atol=1e-9)
+        for name in ("nlp_jac_g", "nlp_grad_f"):
+            for a, b in zip(ours_solver.get_function(name)(x, []), ref_solver.get_function(name)(x, []), strict=True):
+                np.testing.assert_allclose(np.array(ca.DM(a)), np.array(ca.DM(b)), rtol=1e-9, atol=1e-9)
 
 
 @pytest.fixture(scope="module")

@@ -16,6 +16,7 @@ from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
 from designopt.transcriptions.degeneracy import q_independent_rows
 from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
+from designopt.transcriptions.jacobian import assemble_jacobian, block_jacobian_function
 
 
 @dataclass
@@ -70,6 +71,7 @@ class NLP:
         self.n_design = problem.chain.n_design
         self.blocks, self.quadratic = blocks, quadratic
         self._hessians: dict[str, object] = {}
+        self._jacobians: dict[str, object] = {}
 
     def hessian(self, compile_mode: str):
         """hess_lag(x, p, lam_f, lam_g) from the per-point blocks (each block function compiled per
@@ -85,6 +87,39 @@ class NLP:
             self._hessians[compile_mode] = assemble_hessian(self.n_variables, self.n_constraints, groups,
                                                             constant_hessian(self.quadratic, self.x))
         return self._hessians[compile_mode]
+
+    def jacobian(self, compile_mode: str):
+        """jac_g(x, p) -> (g, dg/dx) with the per-point blocks' rows from their (compiled) block Jacobians
+        (`designopt.transcriptions.jacobian`), or None when the NLP has no block structure."""
+        if self.blocks is None:
+            return None
+        if compile_mode not in self._jacobians:
+            groups = []
+            for b in self.blocks:
+                block, rows, cols = block_jacobian_function(b.terms, compile_mode)
+                inputs = list(waypoint_inputs(self.problem.toolpath) if b.inputs is None else b.inputs)
+                groups.append((block, rows, cols, b.y_index, inputs, b.mu_index))
+            self._jacobians[compile_mode] = assemble_jacobian(self.x, self.g, groups)
+        return self._jacobians[compile_mode]
+
+    def gradient(self) -> ca.Function:
+        """grad_f(x, p) -> (f, df/dx), reverse mode on the objective's own expression."""
+        p = ca.SX.sym("p", 0, 1)
+        return ca.Function("grad_f", [self.x, p], [self.f, ca.gradient(self.f, self.x)], ["x", "p"],
+                           ["f", "grad_f_x"])
+
+    def derivatives(self, compile_mode: str) -> tuple[dict, dict]:
+        """(the NLP for nlpsol, the derivative functions for its options): with blocks, hess_lag, jac_g and
+        grad_f are given and the NLP is an MX call of one SX function, so that nlpsol derives nothing itself
+        (it otherwise spends seconds on the SX graph of a cell problem: 6.5 s of the pocket cell's 7.3 s build,
+        benchmarks/speed_table.py); without blocks the SX NLP, for nlpsol to differentiate."""
+        if self.blocks is None:
+            return {"x": self.x, "f": self.f, "g": self.g}, {}
+        fg = ca.Function("nlp_fg", [self.x], [self.f, self.g])
+        X = ca.MX.sym("x", self.n_variables)
+        f, g = fg(X)
+        return {"x": X, "f": f, "g": g}, {"hess_lag": self.hessian(compile_mode),
+                                          "jac_g": self.jacobian(compile_mode), "grad_f": self.gradient()}
 
 
 def constant_hessian(quadratic, x) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

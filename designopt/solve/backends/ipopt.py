@@ -77,16 +77,15 @@ class PreparedIpopt:
         t0 = time.perf_counter()
         self.nlp = nlp
         opts = options(profile)
-        hessian = nlp.hessian(profile.compile)
-        if hessian is not None:
-            opts["hess_lag"] = hessian
+        problem, derivatives = nlp.derivatives(profile.compile)
+        opts.update(derivatives)
         self.observers = make_observers(profile.observers, nlp.problem)
         self._callback = None  # CasADi keeps no Python reference: the callback must live as long as the solver
         if self.observers:
             self._callback = _Observe(self.observers, nlp.n_variables, nlp.n_constraints, nlp.n_design)
             opts["iteration_callback"] = self._callback
             opts["iteration_callback_step"] = OBSERVE_EVERY
-        self.solver = ca.nlpsol(nlp.name, "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
+        self.solver = ca.nlpsol(nlp.name, "ipopt", problem, opts)
         self.prepare_time_s = time.perf_counter() - t0
 
     def solve(self, x0: np.ndarray) -> Outcome:

@@ -1,0 +1,70 @@
+"""Constraint Jacobian assembled from per-point blocks, as the Hessian is (`designopt.transcriptions.hessian`).
+
+Every nonlinear constraint row of a transcribed problem is a row of some c_k(y_k) at one point (a waypoint, a
+collocation point) with y_k = (q_k, q_d); the other rows (collocation ties, midpoint bounds) are linear or small.
+So dg/dx is the small Jacobians dc/dy of one (optionally compiled) block function, evaluated at N points and
+scattered into one sparse matrix, plus the Jacobian of the remaining rows, which CasADi derives from their own,
+small expressions. Deriving it from the whole SX graph instead colours the dense design-joint columns: most of
+the NLP's build time (0.17 s of the main job's, 4.1 s of the pocket cell's; benchmarks/speed_table.py).
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from designopt.transcriptions.compiled import compiled
+
+
+def block_jacobian_function(terms: ca.Function, compile_mode: str) -> tuple[ca.Function, np.ndarray, np.ndarray]:
+    """(function (y, *inputs) -> the structural nonzeros of dc/dy as one column, their rows in c, their columns
+    in y). ``terms`` is a block's (y, *inputs) -> (phi, c)."""
+    y = ca.SX.sym("y", terms.sparsity_in(0))
+    params = [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
+    _, c = terms(y, *params)
+    J = ca.jacobian(c, y)
+    rows, cols = J.sparsity().get_triplet()
+    fn = ca.Function("block_jacobian", [y, *params], [ca.vertcat(*J.nonzeros()) if J.nnz() else ca.SX(0, 1)])
+    return compiled(fn, compile_mode), np.asarray(rows, int), np.asarray(cols, int)
+
+
+def assemble_jacobian(x, g, groups: list[tuple[ca.Function, np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]]
+                      ) -> ca.Function:
+    """jac_g(x, p) -> (g, dg/dx), for nlpsol's ``jac_g`` option.
+
+    ``x``, ``g``: the NLP's SX decision vector and constraints. Each group is (block, rows, cols, y_index,
+    block_inputs, mu_index) with ``block``, ``rows``, ``cols`` from `block_jacobian_function`, ``y_index``
+    (N x n_y) the position in x of each block variable, ``mu_index`` (N x n_c) the position in g of each block
+    row and ``block_inputs`` the block's constant extra inputs (mapped). Rows of g in no group are differentiated
+    from their own expressions.
+    """
+    n_x, n_g = x.shape[0], g.shape[0]
+    in_block = np.zeros(n_g, dtype=bool)
+    triplets = []
+    for _, rows, cols, y_index, _, mu_index in groups:
+        in_block[mu_index.ravel()] = True
+        triplets.append((mu_index[:, rows].ravel(), y_index[:, cols].ravel()))  # point by point, as map stacks them
+    rest = np.flatnonzero(~in_block)
+    J_rest = ca.jacobian(g[ca.DM(rest.tolist())] if rest.size else ca.SX(0, 1), x)
+    r_rows, r_cols = (np.asarray(a, int) for a in J_rest.sparsity().get_triplet())
+    triplets.append((rest[r_rows], r_cols))
+    all_rows = np.concatenate([t[0] for t in triplets])
+    all_cols = np.concatenate([t[1] for t in triplets])
+    order = np.lexsort((all_rows, all_cols))  # CasADi stores nonzeros column by column
+    keys = all_cols[order] * n_g + all_rows[order]
+    if np.any(keys[1:] == keys[:-1]):
+        raise ValueError("two blocks claim the same constraint row")
+    sp = ca.Sparsity.triplet(n_g, n_x, all_rows[order].tolist(), all_cols[order].tolist())
+
+    X = ca.MX.sym("x", n_x)
+    P = ca.MX.sym("p", 0, 1)
+    values = []
+    for block, _, _, y_index, block_inputs, _ in groups:
+        N, n_y = y_index.shape
+        Y = ca.reshape(X[ca.DM(y_index.T.ravel(order="F").tolist())], n_y, N)
+        values.append(ca.vec(block.map(N)(Y, *block_inputs)))
+    rest_fn = ca.Function("jac_rest", [x], [ca.vertcat(*J_rest.nonzeros()) if J_rest.nnz() else ca.SX(0, 1)])
+    values.append(rest_fn(X))
+    nz = ca.vertcat(*values)[ca.DM(order.tolist())]
+    g_fn = ca.Function("g", [x], [g])
+    return ca.Function("jac_g", [X, P], [g_fn(X), ca.MX(sp, nz)], ["x", "p"], ["g", "jac_g_x"])
