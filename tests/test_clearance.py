@@ -6,8 +6,8 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-import coal
 import casadi as ca
+import coal
 import numpy as np
 import pytest
 from typer.testing import CliRunner
