@@ -1,0 +1,157 @@
+"""Issue 24's speed table in one command: per problem, the NLP build (cold: empty compile cache, new process;
+warm: cache filled, new process), and over seeded starts solved one at a time on one core, ms per iteration
+(functions / rest), iterations, the share of inertia-corrected iterations, CPU per solve and the costs reached.
+
+    .venv/bin/python benchmarks/speed_table.py --starts 8 --json new.json
+    .venv/bin/python benchmarks/speed_table.py --compare old.json new.json     # side by side, as ratios
+
+Compare two versions by running this in both (a `git worktree` of the previous commit with its own venv) in the
+same session, then --compare; the machine's load moves both alike. Times are CPU seconds (IPOPT's functions
+from CasADi's t_proc_* timers); builds are wall seconds of a fresh process.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+sys.path.insert(0, str(Path(__file__).parent))
+from iteration_split import FUNCTIONS, logged_solve  # noqa: E402
+
+from designopt.config import load_config  # noqa: E402
+from designopt.experiments.adapters import search_from_config  # noqa: E402
+from designopt.problem import problem_from_config  # noqa: E402
+from designopt.solve.strategies.coarse_to_fine import coarse_problem  # noqa: E402
+
+# name: (config, waypoints (0: all), how the search solves it there: "explore" capped and watched, else "full")
+PROBLEMS = {
+    "main job (80 wp)": ("configs/milling.yaml", 0, "full"),
+    "exploration (10 wp)": ("configs/milling.yaml", 10, "explore"),
+    "sweep structure (40 wp)": ("configs/structures.yaml", 0, "full"),
+    "pocket cell (35 wp)": ("configs/gcode_pocket.yaml", 0, "full"),
+}
+
+
+def setup(config: str, waypoints: int, stage: str, options: tuple = ()):
+    cfg = load_config(Path(config))
+    problem, search = problem_from_config(cfg), search_from_config(cfg)
+    if waypoints:
+        problem = coarse_problem(problem, waypoints)
+    if stage == "explore":
+        profile = search.profile.observing("degenerate").capped(search.explore_max_iter)
+        search = replace(search, profile=profile)
+    if options:
+        search = replace(search, profile=replace(search.profile, options=(*search.profile.options, *options)))
+    return problem, search
+
+
+def build_seconds(name: str, cache: str) -> float:
+    """Wall seconds a new process spends building and preparing problem ``name`` with compile cache ``cache``."""
+    env = {**os.environ, "DESIGNOPT_CACHE": cache}
+    out = subprocess.run([sys.executable, __file__, "--build-only", name], env=env, check=True,
+                         capture_output=True, text=True).stdout
+    return float(out.strip().splitlines()[-1])
+
+
+def measure(name: str, starts: int, options: tuple = ()) -> dict:
+    problem, search = setup(*PROBLEMS[name], options)
+    with tempfile.TemporaryDirectory() as cache:
+        cold, warm = build_seconds(name, cache), build_seconds(name, cache)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for start in range(starts):
+            _, solver, outcome, total, corrected, _ = logged_solve(problem, search, start, Path(tmp) / f"{start}.log")
+            stats = solver.solver.stats()
+            functions = sum(stats.get(f"t_proc_{f}", 0.0) for f in FUNCTIONS)
+            rows.append({"status": outcome.status, "iterations": outcome.iterations, "cpu_s": total,
+                         "functions_s": functions, "corrected": corrected, "cost": outcome.objective})
+    return {"build_cold_s": cold, "build_warm_s": warm, "starts": rows}
+
+
+def summary(m: dict) -> dict:
+    rows = m["starts"]
+    n = [max(r["iterations"], 1) for r in rows]
+    med = statistics.median
+    costs = sorted(r["cost"] for r in rows)
+    return {"build cold [s]": m["build_cold_s"], "build warm [s]": m["build_warm_s"],
+            "ms/iter": med(1e3 * r["cpu_s"] / k for r, k in zip(rows, n, strict=True)),
+            "functions ms/iter": med(1e3 * r["functions_s"] / k for r, k in zip(rows, n, strict=True)),
+            "iterations": med(r["iterations"] for r in rows),
+            "corrected": med(r["corrected"] for r in rows),
+            "CPU/solve [s]": med(r["cpu_s"] for r in rows), "CPU all [s]": sum(r["cpu_s"] for r in rows),
+            "converged": sum(r["status"] == "Solve_Succeeded" for r in rows) / len(rows),
+            "best cost": costs[0], "median cost": med(costs)}
+
+
+def print_table(results: dict, other: dict | None = None) -> None:
+    names = list(results)
+    keys = list(summary(results[names[0]]))
+    head = "| what | " + " | ".join(names) + " |"
+    print(head)
+    print("|---" * (len(names) + 1) + "|")
+    for key in keys:
+        cells = []
+        for name in names:
+            new = summary(results[name])[key]
+            if other is None or name not in other:
+                cells.append(f"{new:.4g}")
+            else:
+                old = summary(other[name])[key]
+                ratio = f" ({new / old:.2f}x)" if old else ""
+                cells.append(f"{old:.4g} -> {new:.4g}{ratio}")
+        print(f"| {key} | " + " | ".join(cells) + " |")
+
+
+def _number(text: str):
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--starts", type=int, default=8)
+    parser.add_argument("--only", action="append", help="a problem name (repeatable; default: all)")
+    parser.add_argument("--json", type=Path, help="write the raw measurements here")
+    parser.add_argument("--compare", type=Path, nargs=2, metavar=("OLD", "NEW"),
+                        help="print two JSON files side by side")
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="an nlpsol option for every solve, e.g. ipopt.mumps_pivot_order=5 (a lever to measure)")
+    parser.add_argument("--build-only", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.build_only:
+        from designopt.solve import local
+        from designopt.transcriptions import Collocation
+        problem, search = setup(*PROBLEMS[args.build_only])
+        t0 = time.perf_counter()
+        local.prepared(problem, Collocation(), search.profile)
+        print(time.perf_counter() - t0)
+        return
+    if args.compare:
+        old, new = (json.loads(p.read_text()) for p in args.compare)
+        print(f"{args.compare[0]} -> {args.compare[1]}")
+        print_table(new, old)
+        return
+    options = tuple((k, _number(v)) for k, v in (o.split("=", 1) for o in args.option))
+    results = {name: measure(name, args.starts, options) for name in (args.only or PROBLEMS)}
+    if args.json:
+        args.json.write_text(json.dumps(results, indent=1))
+    print_table(results)
+
+
+if __name__ == "__main__":
+    main()
