@@ -43,7 +43,7 @@ PROBLEMS = {
 }
 
 
-def setup(config: str, waypoints: int, stage: str, options: tuple = ()):
+def setup(config: str, waypoints: int, stage: str, options: tuple = (), compile_mode: str | None = None):
     cfg = load_config(Path(config))
     problem, search = problem_from_config(cfg), search_from_config(cfg)
     if waypoints:
@@ -53,21 +53,24 @@ def setup(config: str, waypoints: int, stage: str, options: tuple = ()):
         search = replace(search, profile=profile)
     if options:
         search = replace(search, profile=replace(search.profile, options=(*search.profile.options, *options)))
+    if compile_mode:
+        search = replace(search, profile=replace(search.profile, compile=compile_mode))
     return problem, search
 
 
-def build_seconds(name: str, cache: str) -> float:
+def build_seconds(name: str, cache: str, compile_mode: str | None) -> float:
     """Wall seconds a new process spends building and preparing problem ``name`` with compile cache ``cache``."""
     env = {**os.environ, "DESIGNOPT_CACHE": cache}
-    out = subprocess.run([sys.executable, __file__, "--build-only", name], env=env, check=True,
+    mode = ["--compile", compile_mode] if compile_mode else []
+    out = subprocess.run([sys.executable, __file__, "--build-only", name, *mode], env=env, check=True,
                          capture_output=True, text=True).stdout
     return float(out.strip().splitlines()[-1])
 
 
-def measure(name: str, starts: int, options: tuple = ()) -> dict:
-    problem, search = setup(*PROBLEMS[name], options)
+def measure(name: str, starts: int, options: tuple = (), compile_mode: str | None = None) -> dict:
+    problem, search = setup(*PROBLEMS[name], options, compile_mode)
     with tempfile.TemporaryDirectory() as cache:
-        cold, warm = build_seconds(name, cache), build_seconds(name, cache)
+        cold, warm = build_seconds(name, cache, compile_mode), build_seconds(name, cache, compile_mode)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for start in range(starts):
@@ -131,12 +134,13 @@ def main() -> None:
                         help="print two JSON files side by side")
     parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
                         help="an nlpsol option for every solve, e.g. ipopt.mumps_pivot_order=5 (a lever to measure)")
+    parser.add_argument("--compile", help="the solver profile's compile mode (none, O0, O1, O2; default: the config's)")
     parser.add_argument("--build-only", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.build_only:
         from designopt.solve import local
         from designopt.transcriptions import Collocation
-        problem, search = setup(*PROBLEMS[args.build_only])
+        problem, search = setup(*PROBLEMS[args.build_only], compile_mode=args.compile)
         t0 = time.perf_counter()
         local.prepared(problem, Collocation(), search.profile)
         print(time.perf_counter() - t0)
@@ -147,7 +151,7 @@ def main() -> None:
         print_table(new, old)
         return
     options = tuple((k, _number(v)) for k, v in (o.split("=", 1) for o in args.option))
-    results = {name: measure(name, args.starts, options) for name in (args.only or PROBLEMS)}
+    results = {name: measure(name, args.starts, options, args.compile) for name in (args.only or PROBLEMS)}
     if args.json:
         args.json.write_text(json.dumps(results, indent=1))
     print_table(results)

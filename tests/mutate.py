@@ -181,6 +181,13 @@ MUTATIONS = [
              "np.array(data[\"v\"], dtype=float) if \"v\" in data else None, data.get(\"trajectory\"))",
              "np.array(data[\"v\"], dtype=float) if \"v\" in data else None, None)",
              ("tests/test_transcriptions.py",)),
+    Mutation("the block Jacobian's rows scattered one waypoint late", "designopt/transcriptions/jacobian.py",
+             "triplets.append((mu_index[:, rows].ravel(), y_index[:, cols].ravel()))",
+             "triplets.append((np.roll(mu_index, 1, axis=0)[:, rows].ravel(), y_index[:, cols].ravel()))",
+             ("tests/test_transcriptions.py", "tests/test_clearance.py")),
+    Mutation("the rows outside the blocks left out of the Jacobian", "designopt/transcriptions/jacobian.py",
+             "    values.append(rest_fn(X))\n", "    values.append(0 * rest_fn(X))\n",
+             ("tests/test_transcriptions.py", "tests/test_clearance.py")),
 ]
 
 
