@@ -4,6 +4,7 @@ warm: cache filled, new process), and over seeded starts solved one at a time on
 
     .venv/bin/python benchmarks/speed_table.py --starts 8 --json new.json
     .venv/bin/python benchmarks/speed_table.py --compare old.json new.json     # side by side, as ratios
+    .venv/bin/python benchmarks/speed_table.py --build benchmarks/configs/aluminum_button.yaml   # one build
 
 Compare two versions by running this in both (a `git worktree` of the previous commit with its own venv) in the
 same session, then --compare; the machine's load moves both alike. Times are CPU seconds (IPOPT's functions
@@ -135,15 +136,22 @@ def main() -> None:
     parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
                         help="an nlpsol option for every solve, e.g. ipopt.mumps_pivot_order=5 (a lever to measure)")
     parser.add_argument("--compile", help="the solver profile's compile mode (none, O0, O1, O2; default: the config's)")
+    parser.add_argument("--build", metavar="CONFIG", help="only the build (cold, warm) of this config's full problem")
     parser.add_argument("--build-only", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.build_only:
         from designopt.solve import local
         from designopt.transcriptions import Collocation
-        problem, search = setup(*PROBLEMS[args.build_only], compile_mode=args.compile)
+        spec = PROBLEMS.get(args.build_only, (args.build_only, 0, "full"))  # a name, or any config's path
+        problem, search = setup(*spec, compile_mode=args.compile)
         t0 = time.perf_counter()
         local.prepared(problem, Collocation(), search.profile)
         print(time.perf_counter() - t0)
+        return
+    if args.build:
+        with tempfile.TemporaryDirectory() as cache:
+            cold, warm = build_seconds(args.build, cache, args.compile), build_seconds(args.build, cache, args.compile)
+        print(f"{args.build}: build cold {cold:.2f} s, warm {warm:.2f} s (new process each)")
         return
     if args.compare:
         old, new = (json.loads(p.read_text()) for p in args.compare)
