@@ -28,15 +28,16 @@ def block_jacobian_function(terms: ca.Function, compile_mode: str) -> tuple[ca.F
     return compiled(fn, compile_mode), np.asarray(rows, int), np.asarray(cols, int)
 
 
-def assemble_jacobian(x, g, groups: list[tuple[ca.Function, np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]]
+def assemble_jacobian(x, g, g_of: ca.Function,
+                      groups: list[tuple[ca.Function, np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]]
                       ) -> ca.Function:
     """jac_g(x, p) -> (g, dg/dx), for nlpsol's ``jac_g`` option.
 
-    ``x``, ``g``: the NLP's SX decision vector and constraints. Each group is (block, rows, cols, y_index,
-    block_inputs, mu_index) with ``block``, ``rows``, ``cols`` from `block_jacobian_function`, ``y_index``
-    (N x n_y) the position in x of each block variable, ``mu_index`` (N x n_c) the position in g of each block
-    row and ``block_inputs`` the block's constant extra inputs (mapped). Rows of g in no group are differentiated
-    from their own expressions.
+    ``x``, ``g``: the NLP's SX decision vector and constraints; ``g_of``: x -> g as a function. Each group is
+    (block, rows, cols, y_index, block_inputs, mu_index) with ``block``, ``rows``, ``cols`` from
+    `block_jacobian_function`, ``y_index`` (N x n_y) the position in x of each block variable, ``mu_index``
+    (N x n_c) the position in g of each block row and ``block_inputs`` the block's constant extra inputs (mapped).
+    Rows of g in no group are differentiated from their own expressions.
     """
     n_x, n_g = x.shape[0], g.shape[0]
     in_block = np.zeros(n_g, dtype=bool)
@@ -66,5 +67,4 @@ def assemble_jacobian(x, g, groups: list[tuple[ca.Function, np.ndarray, np.ndarr
     rest_fn = ca.Function("jac_rest", [x], [ca.vertcat(*J_rest.nonzeros()) if J_rest.nnz() else ca.SX(0, 1)])
     values.append(rest_fn(X))
     nz = ca.vertcat(*values)[ca.DM(order.tolist())]
-    g_fn = ca.Function("g", [x], [g])
-    return ca.Function("jac_g", [X, P], [g_fn(X), ca.MX(sp, nz)], ["x", "p"], ["g", "jac_g_x"])
+    return ca.Function("jac_g", [X, P], [g_of(X), ca.MX(sp, nz)], ["x", "p"], ["g", "jac_g_x"])

@@ -7,6 +7,7 @@ backend (`designopt.solve.backends`) to solve.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import casadi as ca
@@ -73,17 +74,18 @@ class NLP:
         self._hessians: dict[str, object] = {}
         self._jacobians: dict[str, object] = {}
 
+    def _inputs(self, block: BlockStructure) -> list:
+        """A block's constant inputs, one column per point (the toolpath's `waypoint_inputs` unless it has its own)."""
+        return list(waypoint_inputs(self.problem.toolpath) if block.inputs is None else block.inputs)
+
     def hessian(self, compile_mode: str):
         """hess_lag(x, p, lam_f, lam_g) from the per-point blocks (each block function compiled per
         ``compile_mode``: `designopt.transcriptions.compiled`), or None when the NLP has no block structure."""
         if self.blocks is None:
             return None
         if compile_mode not in self._hessians:
-            groups = []
-            for b in self.blocks:
-                block = block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1], compile_mode)
-                inputs = list(waypoint_inputs(self.problem.toolpath) if b.inputs is None else b.inputs)
-                groups.append((block, b.y_index, inputs, b.mu_index))
+            groups = [(block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1], compile_mode),
+                       b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
             self._hessians[compile_mode] = assemble_hessian(self.n_variables, self.n_constraints, groups,
                                                             constant_hessian(self.quadratic, self.x))
         return self._hessians[compile_mode]
@@ -94,32 +96,41 @@ class NLP:
         if self.blocks is None:
             return None
         if compile_mode not in self._jacobians:
-            groups = []
-            for b in self.blocks:
-                block, rows, cols = block_jacobian_function(b.terms, compile_mode)
-                inputs = list(waypoint_inputs(self.problem.toolpath) if b.inputs is None else b.inputs)
-                groups.append((block, rows, cols, b.y_index, inputs, b.mu_index))
-            self._jacobians[compile_mode] = assemble_jacobian(self.x, self.g, groups)
+            groups = [(*block_jacobian_function(b.terms, compile_mode), b.y_index, self._inputs(b), b.mu_index)
+                      for b in self.blocks]
+            self._jacobians[compile_mode] = assemble_jacobian(self.x, self.g, self._functions[1], groups)
         return self._jacobians[compile_mode]
 
+    @functools.cached_property
+    def _functions(self) -> tuple[ca.Function, ca.Function]:
+        """(x -> f, x -> g): the objective and the constraints as SX functions, set up once (on a long program
+        each takes seconds) and shared by the oracle and jac_g."""
+        return ca.Function("nlp_f", [self.x], [self.f]), ca.Function("nlp_g", [self.x], [self.g])
+
+    @functools.cached_property
     def gradient(self) -> ca.Function:
         """grad_f(x, p) -> (f, df/dx), reverse mode on the objective's own expression."""
         p = ca.SX.sym("p", 0, 1)
         return ca.Function("grad_f", [self.x, p], [self.f, ca.gradient(self.f, self.x)], ["x", "p"],
                            ["f", "grad_f_x"])
 
+    @functools.cached_property
+    def _oracle(self) -> dict:
+        """The NLP for nlpsol as MX calls of the SX functions `_functions`."""
+        X = ca.MX.sym("x", self.n_variables)
+        f_of, g_of = self._functions
+        return {"x": X, "f": f_of(X), "g": g_of(X)}
+
     def derivatives(self, compile_mode: str) -> tuple[dict, dict]:
         """(the NLP for nlpsol, the derivative functions for its options): with blocks, hess_lag, jac_g and
-        grad_f are given and the NLP is an MX call of one SX function, so that nlpsol derives nothing itself
+        grad_f are given and the NLP is an MX call of SX functions, so that nlpsol derives nothing itself
         (it otherwise spends seconds on the SX graph of a cell problem: 6.5 s of the pocket cell's 7.3 s build,
-        benchmarks/speed_table.py); without blocks the SX NLP, for nlpsol to differentiate."""
+        benchmarks/speed_table.py); without blocks the SX NLP, for nlpsol to differentiate. Every piece is built
+        once per NLP and shared by the solvers of all its profiles."""
         if self.blocks is None:
             return {"x": self.x, "f": self.f, "g": self.g}, {}
-        fg = ca.Function("nlp_fg", [self.x], [self.f, self.g])
-        X = ca.MX.sym("x", self.n_variables)
-        f, g = fg(X)
-        return {"x": X, "f": f, "g": g}, {"hess_lag": self.hessian(compile_mode),
-                                          "jac_g": self.jacobian(compile_mode), "grad_f": self.gradient()}
+        return self._oracle, {"hess_lag": self.hessian(compile_mode), "jac_g": self.jacobian(compile_mode),
+                              "grad_f": self.gradient}
 
 
 def constant_hessian(quadratic, x) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
