@@ -28,6 +28,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 sys.path.insert(0, str(Path(__file__).parent))
+import yaml  # noqa: E402
 from iteration_split import FUNCTIONS, logged_solve  # noqa: E402
 
 from designopt.config import load_config  # noqa: E402
@@ -117,15 +118,6 @@ def print_table(results: dict, other: dict | None = None) -> None:
         print(f"| {key} | " + " | ".join(cells) + " |")
 
 
-def _number(text: str):
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--starts", type=int, default=8)
@@ -158,7 +150,7 @@ def main() -> None:
         print(f"{args.compare[0]} -> {args.compare[1]}")
         print_table(new, old)
         return
-    options = tuple((k, _number(v)) for k, v in (o.split("=", 1) for o in args.option))
+    options = tuple((k, yaml.safe_load(v)) for k, v in (o.split("=", 1) for o in args.option))  # as search_seeds --set
     results = {name: measure(name, args.starts, options, args.compile) for name in (args.only or PROBLEMS)}
     if args.json:
         args.json.write_text(json.dumps(results, indent=1))
