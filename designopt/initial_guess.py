@@ -12,10 +12,12 @@ tracking to the solver.
 
 from __future__ import annotations
 
+import functools
+import pickle
+
 import numpy as np
 
-from designopt.costs import tracking_residual
-from designopt.kinematics.chain import geometric_jacobian, placement_pose, tool_pose
+from designopt.costs import tracking_residual, waypoint
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
@@ -49,32 +51,27 @@ def random_configuration(problem: DesignProblem, rng: np.random.Generator) -> np
     return np.array(out)
 
 
-def ik_residual(problem: DesignProblem, q: np.ndarray, q_d: np.ndarray, k: int):
-    """Tracking residual at waypoint k in W (position; tool axis minus (0, 0, -1)) and its Jacobian."""
-    chain, tp = problem.chain, problem.toolpath
-    T_BW = placement_pose(chain, q, q_d)
-    R_WB = T_BW[:3, :3].T
-    T = tool_pose(chain, q, q_d)
-    J = geometric_jacobian(chain, q, q_d)
-    z = T[:3, 2]
-    r = np.concatenate([R_WB @ (T[:3, 3] - T_BW[:3, 3]) - tp.points_W[k], R_WB @ z - np.array([0.0, 0.0, -1.0])])
-    Jz = np.cross(J[3:, :].T, z).T  # dz/dq_i = omega_i x z
-    return r, np.vstack([R_WB @ J[:3, :], R_WB @ Jz])
-
-
 def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, iterations: int = 30) -> np.ndarray:
     """Damped least-squares IK along the path, each waypoint starting from the previous solution."""
+    fn = residual_function(problem)
+    points = problem.toolpath.points_W
+
+    def residual(q, k):
+        r, J_q, _ = fn(q, q_d, points[k])
+        return np.array(r).ravel(), np.array(J_q)
+
     lo = np.array([j.lower for j in problem.chain.moving])
     hi = np.array([j.upper for j in problem.chain.moving])
     Q = np.empty((problem.toolpath.n, len(q0)))
     q = np.array(q0, dtype=float)
+    eye = np.eye(len(q))
     for k in range(problem.toolpath.n):
         damping = 1e-2
-        r, J = ik_residual(problem, q, q_d, k)
+        r, J = residual(q, k)
         for _ in range(iterations if k == 0 else max(8, iterations // 3)):
-            step = np.linalg.solve(J.T @ J + damping * np.eye(len(q)), -J.T @ r)
+            step = np.linalg.solve(J.T @ J + damping * eye, -J.T @ r)
             trial = np.clip(q + step, lo, hi)
-            r_new, J_new = ik_residual(problem, trial, q_d, k)
+            r_new, J_new = residual(trial, k)
             if r_new @ r_new < r @ r:
                 q, r, J, damping = trial, r_new, J_new, max(damping / 3, 1e-6)
             else:
@@ -98,7 +95,7 @@ def reach(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations: in
     N, n_m, n_d = len(ks), chain.n_moving, chain.n_design
     lo = np.concatenate([[j.lower for j in chain.design], np.tile([j.lower for j in chain.moving], N)])
     hi = np.concatenate([[j.upper for j in chain.design], np.tile([j.upper for j in chain.moving], N)])
-    fn = _residual_function(problem).map(N)
+    fn = residual_function(problem).map(N)
     S = problem.toolpath.points_W[ks].T
     rows = np.arange(6 * N).reshape(N, 6)
 
@@ -126,14 +123,22 @@ def reach(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations: in
     return z[:n_d], z[n_d:].reshape(N, n_m)
 
 
-def _residual_function(problem: DesignProblem):
-    """(q, q_d, s_W) -> tracking residual (p_W - s_W, z_W - (0, 0, -1)) and its Jacobians in q and q_d."""
+def residual_function(problem: DesignProblem):
+    """(q, q_d, s_W) -> tracking residual (p_W - s_W, z_W - (0, 0, -1)) and its Jacobians in q and q_d: a CasADi
+    function of the problem's chain, built once per chain in a process (a numpy walk of the chain costs ~20x more
+    per call, and starts call it ~100 times per waypoint)."""
+    return _residual_function(pickle.dumps(problem.chain))
+
+
+@functools.lru_cache(maxsize=16)
+def _residual_function(payload: bytes):
     import casadi as ca
 
-    chain = problem.chain
+    chain = pickle.loads(payload)
     q, q_d, s_W = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design), ca.SX.sym("s_W", 3)
-    r = ca.vertcat(*tracking_residual(problem.waypoint(q, q_d, s_W, ca.SX.zeros(3))))
-    return ca.Function("reach", [q, q_d, s_W], [r, ca.jacobian(r, q), ca.jacobian(r, q_d)])
+    w = waypoint(chain, q, q_d, s_W, ca.SX.zeros(3), None, "full")
+    r = ca.vertcat(*tracking_residual(w))
+    return ca.Function("tracking_residual", [q, q_d, s_W], [r, ca.jacobian(r, q), ca.jacobian(r, q_d)])
 
 
 def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik",
@@ -173,11 +178,11 @@ def design_from(problem: DesignProblem, other: DesignProblem, q_d_other: np.ndar
 
 def tracks(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray) -> bool:
     """Whether joint values Q with design q_d follow the path within the problem's tolerances."""
-    tracked = problem.toolpath.is_tracked
+    tracked, points, fn = problem.toolpath.is_tracked, problem.toolpath.points_W, residual_function(problem)
     for k, q in enumerate(Q):
         if not tracked[k]:
             continue
-        r = ik_residual(problem, q, q_d, k)[0]
+        r = np.array(fn(q, q_d, points[k])[0]).ravel()
         if np.linalg.norm(r[:3]) > problem.position_tol or np.linalg.norm(r[3:]) > problem.axis_tol:
             return False
     return True

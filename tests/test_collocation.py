@@ -115,6 +115,36 @@ def test_ik_start_tracks_a_reachable_path():
     assert m.max_joint_step < 0.5  # one branch, no jumps
 
 
+@pytest.mark.parametrize("structure", ["RRRRRR", "RPRRPR"])
+def test_the_ik_residual_is_the_numpy_kinematics_and_its_jacobian_their_derivative(structure):
+    """Starts walk the path with a CasADi function of the tracking residual: at random joints, designs and
+    points it equals the residual of the numpy kinematics the verifier uses, and its Jacobians in q and q_d equal
+    central differences of that numpy residual."""
+    from designopt.costs import tracking_residual
+    from designopt.initial_guess import residual_function
+
+    problem = problem_from_config(parse_config({"robot": {"structure": structure},
+                                                "design": ["d", "a", "alpha", "placement"]}))
+    fn, rng = residual_function(problem), np.random.default_rng(3)
+
+    def numpy_residual(q, q_d, s):
+        return np.concatenate(tracking_residual(problem.waypoint(q, q_d, s, np.zeros(3))))
+
+    for _ in range(3):
+        q = rng.uniform(-1, 1, problem.chain.n_moving)
+        q_d = problem.chain.design_values + rng.uniform(-0.2, 0.2, problem.chain.n_design)
+        s = rng.uniform(-0.3, 0.3, 3)
+        r, J_q, J_d = (np.array(x) for x in fn(q, q_d, s))
+        np.testing.assert_allclose(r.ravel(), numpy_residual(q, q_d, s), atol=1e-12)
+        h = 1e-6
+        fd_q = np.column_stack([(numpy_residual(q + h * e, q_d, s) - numpy_residual(q - h * e, q_d, s)) / (2 * h)
+                                for e in np.eye(len(q))])
+        fd_d = np.column_stack([(numpy_residual(q, q_d + h * e, s) - numpy_residual(q, q_d - h * e, s)) / (2 * h)
+                                for e in np.eye(len(q_d))])
+        np.testing.assert_allclose(J_q, fd_q, atol=1e-7)
+        np.testing.assert_allclose(J_d, fd_d, atol=1e-7)
+
+
 def test_a_failed_solve_is_a_result_not_an_exception(gantry_problem):
     raw = solve_from(gantry_problem, initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0], max_iter=2).raw
     assert not raw.success
