@@ -188,6 +188,9 @@ MUTATIONS = [
     Mutation("the rows outside the blocks left out of the Jacobian", "designopt/transcriptions/jacobian.py",
              "    values.append(rest_fn(X))\n", "    values.append(0 * rest_fn(X))\n",
              ("tests/test_transcriptions.py", "tests/test_clearance.py")),
+    Mutation("the starts' IK Jacobian scaled (the walk still converges, slower and elsewhere)",
+             "designopt/initial_guess.py", "[r, ca.jacobian(r, q), ca.jacobian(r, q_d)]",
+             "[r, 2 * ca.jacobian(r, q), ca.jacobian(r, q_d)]", ("tests/test_collocation.py",)),
 ]
 
 
