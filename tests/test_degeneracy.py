@@ -113,6 +113,7 @@ def test_a_solve_stalled_on_a_planar_design_is_finished_with_its_twists_held(hol
     sol = solve(problem, index=3, max_iter=1000, hold_degenerate=True)
     assert sol.raw.success, sol.raw.status
     assert sol.raw.held.split() == [j.name for j in problem.chain.design if j.name.endswith(".alpha")]
+    assert sol.raw.iterations < 1000  # the watch stopped the creep: unwatched, it alone would take the cap
     assert sol.metrics.tracks
     assert sol.metrics.design_cost < 0.5 * stalled.metrics.design_cost
     again = evaluate(problem, sol.raw.q_d, sol.raw.trajectory)  # a solution of the problem as posed
