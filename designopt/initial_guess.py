@@ -124,9 +124,10 @@ def reach(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations: in
 
 
 def residual_function(problem: DesignProblem):
-    """(q, q_d, s_W) -> tracking residual (p_W - s_W, z_W - (0, 0, -1)) and its Jacobians in q and q_d: a CasADi
-    function of the problem's chain, built once per chain in a process (a numpy walk of the chain costs ~20x more
-    per call, and starts call it ~100 times per waypoint)."""
+    """(q, q_d, s_W) -> tracking residual r = (p_W - s_W [m], z_W - (0, 0, -1)), in the workpiece frame W, and its
+    Jacobians dr/dq and dr/dq_d (6 x n_moving, 6 x n_design): a CasADi function of the problem's chain, built once
+    per chain in a process (a numpy walk of the chain costs ~20x more per call, and starts call it ~100 times per
+    waypoint). s_W: a path point in W [m]."""
     return _residual_function(pickle.dumps(problem.chain))
 
 
