@@ -16,6 +16,15 @@ import numpy as np
 from designopt.transcriptions.compiled import compiled
 
 
+def per_point(v: ca.MX, index: np.ndarray) -> ca.MX:
+    """The entries of ``v`` at ``index`` (N points x n entries) as an n x N matrix, one column per point: the
+    argument a block function mapped over the N points takes."""
+    n_points, n = index.shape
+    if not index.size:
+        return ca.MX(n, n_points)
+    return ca.reshape(v[ca.DM(index.T.ravel(order="F").tolist())], n, n_points)
+
+
 def block_hessian_function(terms: ca.Function, n_y: int, n_c: int, compile_mode: str) -> ca.Function:
     """Upper-triangular entries (row-major over a <= b) of d2/dy2 [sigma phi(y) + mu . c(y)]."""
     y = ca.SX.sym("y", n_y)
@@ -72,11 +81,8 @@ def assemble_hessian(
     lam_g = ca.MX.sym("lam_g", n_g)
     values = []
     for block, y_index, block_inputs, mu_index in groups:
-        N, n_y = y_index.shape
-        Y = ca.reshape(x[ca.DM(y_index.T.ravel(order="F").tolist())], n_y, N)
-        mu = ca.reshape(lam_g[ca.DM(mu_index.T.ravel(order="F").tolist())], mu_index.shape[1], N) \
-            if mu_index.size else ca.MX(0, N)
-        values.append(ca.vec(block.map(N)(Y, lam_f, mu, *block_inputs)))
+        N = y_index.shape[0]
+        values.append(ca.vec(block.map(N)(per_point(x, y_index), lam_f, per_point(lam_g, mu_index), *block_inputs)))
     nz = ca.mtimes(scatter, ca.vertcat(*values)) + lam_f * ca.DM(const_vals)
     H = ca.MX(sp, nz)
     return ca.Function("hess_lag", [x, p, lam_f, lam_g], [H], ["x", "p", "lam_f", "lam_g"], ["hess"])

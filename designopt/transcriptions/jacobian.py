@@ -14,6 +14,7 @@ import casadi as ca
 import numpy as np
 
 from designopt.transcriptions.compiled import compiled
+from designopt.transcriptions.hessian import per_point
 
 
 def block_jacobian_function(terms: ca.Function, compile_mode: str) -> tuple[ca.Function, np.ndarray, np.ndarray]:
@@ -61,9 +62,7 @@ def assemble_jacobian(x, g, g_of: ca.Function,
     P = ca.MX.sym("p", 0, 1)
     values = []
     for block, _, _, y_index, block_inputs, _ in groups:
-        N, n_y = y_index.shape
-        Y = ca.reshape(X[ca.DM(y_index.T.ravel(order="F").tolist())], n_y, N)
-        values.append(ca.vec(block.map(N)(Y, *block_inputs)))
+        values.append(ca.vec(block.map(y_index.shape[0])(per_point(X, y_index), *block_inputs)))
     rest_fn = ca.Function("jac_rest", [x], [ca.vertcat(*J_rest.nonzeros()) if J_rest.nnz() else ca.SX(0, 1)])
     values.append(rest_fn(X))
     nz = ca.vertcat(*values)[ca.DM(order.tolist())]
