@@ -64,6 +64,7 @@ def main() -> None:
     parser.add_argument("--refine", type=int, default=200)
     parser.add_argument("--sample", type=int, default=60)
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--compile", default="O0", help="the screening's derivative blocks (SolverProfile.compile)")
     parser.add_argument("--reference", default=str(ROOT / "benchmarks" / "reference" / "modular_best_known.json"))
     parser.add_argument("--limit", type=int, default=None, help="only the first N assignments (a trial run)")
     args = parser.parse_args()
@@ -79,7 +80,8 @@ def main() -> None:
     execute_full = Executor(run, "modular_enumeration", args.jobs, resume=True)
 
     # 1. screen every assignment on the coarse path
-    screen = preset("paper", starts=args.starts, init="reach", profile=SolverProfile(max_iter=250))
+    profile = SolverProfile(max_iter=250, compile=args.compile)
+    screen = preset("paper", starts=args.starts, init="reach", profile=profile)
     for first in range(0, len(assignments), BATCH):
         batch = assignments[first:first + BATCH]
         jobs = [Job(f"s{label(a)}", coarse_problem(fix_modules(base, list(a), catalogue, placement), 10))

@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 import yaml
 from conftest import solve
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from designopt.config import parse_config
 from designopt.experiments.adapters import search_from_config
@@ -20,7 +22,9 @@ from designopt.solve import (
     PRESETS,
     Job,
     Search,
+    Seeded,
     SolverProfile,
+    Task,
     distinct_best,
     lifted_guess,
     preset,
@@ -28,7 +32,9 @@ from designopt.solve import (
     run_task,
 )
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
+from designopt.solve.tasks import units
 from designopt.toolpaths import figure_eight, subsample
+from designopt.transcriptions import Collocation
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -168,3 +174,28 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     assert waypoints == {"explore": 6, "screen": 9, "refine": 12}
     assert max(s.raw.iterations for t, s in done if t.stage == "screen") == 25  # 25 do not converge on 9 waypoints
     assert max(s.raw.iterations for t, s in done if t.stage == "refine") > 25
+
+
+@settings(max_examples=60, deadline=None)
+@given(starts=st.lists(st.integers(1, 12), min_size=1, max_size=12), workers=st.integers(1, 4))
+def test_a_problems_starts_go_to_one_worker_when_there_are_problems_enough(starts, workers):
+    """`units`: every task dispatched exactly once, in its order; a unit holds one problem's starts only; starts are
+    grouped when there are at least two problems per worker (else one task per unit), in pieces of at most a
+    quarter of a worker's share."""
+    problems = [object() for _ in starts]
+    profile, transcription = SolverProfile(), Collocation()
+    tasks = [Task("c", "explore", p, transcription, profile, Seeded(0, i))
+             for p, n in zip(problems, starts, strict=True) for i in range(n)]
+    dispatched = units(tasks, workers)
+    flat = [t for u in dispatched for t in u]
+    assert sorted(map(id, flat)) == sorted(map(id, tasks))
+    for u in dispatched:
+        assert len({id(t.problem) for t in u}) == 1
+        assert [t.start.index for t in u] == sorted(t.start.index for t in u)
+    if len(problems) < 2 * workers:
+        assert all(len(u) == 1 for u in dispatched)
+    else:
+        most = max(1, len(tasks) // (4 * workers))
+        assert all(len(u) <= most for u in dispatched)
+        # a problem is cut only where the cap forces it
+        assert len(dispatched) == sum(-(-n // most) for n in starts)

@@ -57,13 +57,34 @@ def _run(task: Task) -> tuple[Task, Solution]:
     return task, run_task(task)
 
 
+def _run_all(unit: list[Task]) -> list[tuple[Task, Solution]]:
+    return [_run(t) for t in unit]
+
+
+def units(tasks: list[Task], workers: int) -> list[list[Task]]:
+    """How tasks go to workers: every start of one problem (the same problem object, transcription and profile) in
+    one unit when there are at least two such groups per worker -- a worker then builds and prepares each
+    problem's NLP once instead of every worker building it (a modular enumeration's assignments, a sweep's
+    structures) -- else one task per unit, so that the starts of a few problems spread over every worker.
+    A group is cut into pieces of at most len(tasks) / (4 workers) tasks, so that no unit is a long tail."""
+    groups: dict[tuple, list[Task]] = {}
+    for t in tasks:
+        groups.setdefault((id(t.problem), t.transcription, t.profile), []).append(t)
+    if len(groups) < 2 * workers:
+        return [[t] for t in tasks]
+    most = max(1, len(tasks) // (4 * workers))
+    return [group[i : i + most] for group in groups.values() for i in range(0, len(group), most)]
+
+
 def fan_out(tasks: list[Task], jobs: int | None) -> Iterator[tuple[Task, Solution]]:
     """Yield (task, solution) as tasks finish: in this process if jobs == 1, else joblib processes (jobs = -1:
-    every core; None: joblib's active backend decides, e.g. a Dask cluster)."""
+    every core; None: joblib's active backend decides, e.g. a Dask cluster), the tasks dispatched in `units`."""
     if jobs == 1 or len(tasks) <= 1:
         for t in tasks:
             yield _run(t)
         return
-    from joblib import Parallel, delayed
+    from joblib import Parallel, delayed, effective_n_jobs
 
-    yield from Parallel(n_jobs=jobs, return_as="generator_unordered")(delayed(_run)(t) for t in tasks)
+    dispatched = units(tasks, effective_n_jobs(jobs))
+    for done in Parallel(n_jobs=jobs, return_as="generator_unordered")(delayed(_run_all)(u) for u in dispatched):
+        yield from done
