@@ -95,8 +95,12 @@ def main() -> None:
 
     # 2. refine the best by screening, 3. and a random sample, each with the default search on the full path
     rng = np.random.default_rng(2026)
-    sample = [label(assignments[i]) for i in rng.choice(len(assignments), args.sample, replace=False)]
+    sample = [label(assignments[i]) for i in rng.choice(len(assignments), min(args.sample, len(assignments)),
+                                                        replace=False)]
     chosen = list(dict.fromkeys([*ranked.index[: args.refine], *sample]))
+    if not chosen:  # --refine 0 --sample 0: a screening run only
+        print(ranked.head(15).to_string(), flush=True)
+        return
     full = replace(preset("default"), init="reach")
     for first in range(0, len(chosen), BATCH // 10):
         batch = chosen[first:first + BATCH // 10]
