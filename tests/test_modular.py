@@ -112,17 +112,22 @@ def test_modular_command_writes_every_stage(tmp_path):
     from designopt.verify import verify_file
 
     config = tmp_path / "m.yaml"
-    config.write_text(yaml.safe_dump({"name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 10},
+    config.write_text(yaml.safe_dump({"name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 12},
                                       "placement": {"xyz": [0.45, 0.0, -0.2]},
                                       "search": {"preset": "paper", "starts": 1}}))
-    result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path / "r"), "--name", "t"])
+    result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path / "r"), "--name", "t",
+                                      "--budget", "30"])
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "modular" / "t"
     summary = pd.read_csv(run / "summary.csv")
     stages = set(summary["case"])
     assert {"continuous", "continuous_modular", "rounded", "modular", "fk"} <= stages
-    neighbours = {c for c in stages if c.startswith("nb-")}  # the neighbourhood search's candidates
-    assert 1 <= len(neighbours) <= 47  # the rounded assignment itself is the modular stage
+    screened = {c for c in stages if c.startswith("sc-")}  # the neighbourhood search's screened candidates
+    assert len(screened) == 30  # the budget, all spent: eight random restarts are more than 30 can finish
+    size = summary.groupby(summary["case"].str[:3])["n_variables"].agg(set)
+    assert len(size["sc-"]) == 1 and max(size["sc-"]) < min(size["nb-"])  # screened on 10 of the 12 waypoints
+    refined = {c for c in stages if c.startswith("nb-")}  # the best screened, re-solved on the full path
+    assert 1 <= len(refined) <= 8
     table = pd.read_csv(run / "table.csv").set_index("stage")
     # the search starts from the rounded assignment and never ends worse than its re-solve
     assert table.loc["neighbourhood", "design_cost"] <= table.loc["modular", "design_cost"] * (1 + 1e-9)

@@ -5,8 +5,10 @@ Stages, each written to summary.csv as a ``case``:
   continuous_modular  TO with weight * L_mod added: links are pulled toward catalogue modules
   rounded             every link replaced by its nearest module, evaluated on the stage-2 trajectory
   modular             modules fixed; placement and trajectory re-solved (the modular design)
-  neighbourhood       beyond the paper: a local search over module assignments from the rounded one (one link's
-                      module changed at a time, each candidate re-solved like ``modular``; cases nb-<modules>)
+  neighbourhood       beyond the paper: a search over module assignments, coarse to fine like the continuous one --
+                      a local search (one link's module changed at a time) from the rounded assignment and from
+                      seeded random ones, each candidate screened on a coarse sampling of the path (cases
+                      sc-<modules>); the best screened re-solved like ``modular`` (cases nb-<modules>)
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 
 Every stage is a search of one problem (the config's search: the shipped config uses the ``paper`` preset).
@@ -38,13 +40,17 @@ from designopt.modular import (
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
-from designopt.solve import Job, Search, Seeded, SolverProfile, Task, run_search
+from designopt.solve import Job, Search, Seeded, SolverProfile, Task, preset, run_search
+from designopt.solve.strategies.coarse_to_fine import coarse_problem
 from designopt.transcriptions import ForwardKinematics
 
 STAGES = ("continuous", "continuous_modular", "rounded", "modular", "neighbourhood", "fk")
 WEIGHT = 1.0e-3  # L_mod's weight in the objective
 WEIGHT_STUDY = (1.0e-4, 1.0e-3, 1.0e-2)
-NEIGHBOURHOOD_BUDGET = 48  # module assignments the neighbourhood search may evaluate
+NEIGHBOURHOOD_BUDGET = 300  # module assignments the neighbourhood search may screen
+NEIGHBOURHOOD_RESTARTS = 8  # seeded random assignments it starts from after the rounded one
+NEIGHBOURHOOD_REFINE = 8  # best screened assignments re-solved on the full path
+SCREEN_WAYPOINTS = 10  # the screening's sampling of the path
 # w_lin (1/m^2) and w_ang of the similarity distance (SPEC §3)
 LINEAR_WEIGHT, ANGULAR_WEIGHT = 1.0, 0.25
 
@@ -135,12 +141,9 @@ def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progre
     best["continuous_modular"], best["modular"] = continuous, modular
     searched = assignment
     if modular is not None and neighbourhood_budget:
-        evaluate = ModuleCosts(s, base, catalogue, placement, "nb-")
-        evaluate.best[tuple(assignment)] = modular  # the start is the modular stage, already solved
-        searched, _, evaluated = neighbourhood_search([tuple(assignment)], len(catalogue.modules), evaluate,
-                                                      neighbourhood_budget)
-        best["neighbourhood"] = evaluate.best[tuple(searched)]
-        run.log(f"neighbourhood search: {len(evaluated)} assignments evaluated, best {[k + 1 for k in searched]}")
+        searched, best["neighbourhood"], screened = _module_search(s, base, catalogue, placement, assignment, modular,
+                                                                    neighbourhood_budget)
+        run.log(f"neighbourhood search: {screened} assignments screened, best {[k + 1 for k in searched]}")
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
         # not a solve: derived from the stage-2 best, so it is recorded once and recomputed on resume
@@ -189,25 +192,66 @@ def _round_and_resolve(setup, base, catalogue, weight, tag):
     return continuous, assignment, modular, placement
 
 
+def module_screen(search: Search) -> Search:
+    """How the neighbourhood search screens an assignment: 3 seeded starts (the search's seed) on
+    `SCREEN_WAYPOINTS` of the path, moved until they reach it (``init: reach``), capped at 250 iterations,
+    derivative blocks interpreted (each shape is solved three times: compiling would cost more than it saves)."""
+    profile = SolverProfile(max_iter=250, compile="none")
+    return preset("paper", starts=3, seed=search.seed, init="reach", profile=profile)
+
+
+def random_assignments(count: int, n_links: int, n_modules: int, seed: int) -> list[tuple[int, ...]]:
+    """``count`` module assignments drawn uniformly, from ``seed`` alone."""
+    rng = np.random.default_rng([seed, 25])
+    return [tuple(int(k) for k in rng.integers(0, n_modules, n_links)) for _ in range(count)]
+
+
+def _module_search(setup, base, catalogue, placement, rounded, modular, budget, restarts=NEIGHBOURHOOD_RESTARTS,
+                   refine=NEIGHBOURHOOD_REFINE):
+    """The neighbourhood stage: a local search over assignments on screening costs, from the rounded assignment
+    and ``restarts`` seeded random ones, within ``budget`` screened assignments; then the ``refine`` best screened
+    re-solved on the full path like the modular stage. Returns (best assignment, its solution, assignments
+    screened); never worse than the rounded assignment's re-solve ``modular``."""
+    n_modules = len(catalogue.modules)
+    screen = ModuleCosts(setup, base, catalogue, placement, "sc-", module_screen(setup.search), SCREEN_WAYPOINTS)
+    starts = [tuple(rounded), *random_assignments(restarts, base.chain.n_links, n_modules, setup.search.seed)]
+    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget)
+    ranked = sorted((a for a, c in evaluated if np.isfinite(c)), key=dict(evaluated).get)[:refine]
+    full = ModuleCosts(setup, base, catalogue, placement, "nb-")
+    full.best[tuple(rounded)] = modular  # already solved: the modular stage
+    full(ranked)
+    solved = {a: sol for a, sol in full.best.items() if sol is not None and sol.metrics.tracks}
+    if not solved:
+        return list(rounded), modular, len(evaluated)
+    best = min(solved, key=lambda a: solved[a].metrics.design_cost)
+    return list(best), solved[best], len(evaluated)
+
+
 def _digits(assignment) -> str:
     return "".join(str(k + 1) for k in assignment)
 
 
 class ModuleCosts:
     """``evaluate(assignments) -> costs`` for `neighbourhood_search`: every assignment's modules-fixed problem
-    (placement and trajectory free, from the rounded stage's placement) searched like the ``modular`` stage, all
-    of a batch in one search (cases ``<tag><module numbers>``); NaN when no start tracks. ``best`` keeps each
-    evaluated assignment's best solution."""
+    (placement and trajectory free, from the rounded stage's placement; on ``waypoints`` of the path, None: all)
+    searched with ``search`` (None: the experiment's, like the ``modular`` stage), all of a batch in one search
+    (cases ``<tag><module numbers>``); NaN when no start tracks. ``best`` keeps each evaluated assignment's best
+    solution."""
 
-    def __init__(self, setup, base, catalogue, placement, tag):
+    def __init__(self, setup, base, catalogue, placement, tag, search: Search | None = None,
+                 waypoints: int | None = None):
         self.setup, self.base, self.catalogue, self.placement, self.tag = setup, base, catalogue, placement, tag
+        self.search, self.waypoints = search or setup.search, waypoints
         self.best: dict[tuple[int, ...], Solution | None] = {}
+
+    def problem(self, assignment) -> DesignProblem:
+        fixed = fix_modules(self.base, list(assignment), self.catalogue, self.placement)
+        return fixed if self.waypoints is None else coarse_problem(fixed, self.waypoints)
 
     def __call__(self, batch):
         todo = [a for a in batch if a not in self.best]  # known already: e.g. the rounded assignment's re-solve
-        jobs = [Job(f"{self.tag}{_digits(a)}", fix_modules(self.base, list(a), self.catalogue, self.placement))
-                for a in todo]
-        for a, searched in zip(todo, run_search(jobs, self.setup.search, self.setup.execute), strict=True):
+        jobs = [Job(f"{self.tag}{_digits(a)}", self.problem(a)) for a in todo]
+        for a, searched in zip(todo, run_search(jobs, self.search, self.setup.execute), strict=True):
             self.best[a] = searched.best[1]
         return [self.best[a].metrics.design_cost if self.best[a] is not None else np.nan for a in batch]
 

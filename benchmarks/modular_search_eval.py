@@ -1,0 +1,87 @@
+"""The modular neighbourhood search replayed on the enumeration's screening: how often it ends at the best assignment.
+
+Reads a finished `modular_enumeration.py` run (every assignment's screening cost on the coarse path, and the
+full-path cost of the best screened and of a random sample) and replays the neighbourhood stage of `designopt
+modular` (`designopt.experiments.modular`: a local search over one-link changes on screening costs from a start
+assignment and seeded random ones, then the best screened re-solved on the full path) for many seeds, with the
+enumeration's costs in place of the solves. Prints, per budget, the distribution over seeds of (the search's
+full-path answer / the best full-path cost of the enumeration) and how many assignments it screened.
+
+The replay uses the enumeration's screening (search seed 0) for every seed: what it measures is the local
+search and its restarts, not the screening's own seed-to-seed noise (real runs: docs/results.md).
+
+    .venv/bin/python benchmarks/modular_search_eval.py RUN_DIR [--first-seed 1000] [--seeds 20]
+        [--budget 100 200 300] [--restarts 8] [--refine 8] [--start 111111]
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from designopt.experiments.modular import random_assignments
+from designopt.modular import neighbourhood_search
+from designopt.tables import COARSE_STAGES
+
+
+def costs(run: Path) -> tuple[dict, dict]:
+    """(screening cost, full-path cost) per assignment (tuples of 0-based module indices); inf: does not track."""
+    summary = pd.read_csv(run / "summary.csv")
+    tracks = summary["tracks"].astype(str) == "True"
+    out = []
+    for prefix, rows in (("s", summary[tracks]), ("f", summary[tracks & ~summary["stage"].isin(COARSE_STAGES)])):
+        rows = rows[rows["case"].astype(str).str.startswith(prefix)]
+        best = rows.groupby("case")["design_cost"].min()
+        out.append({tuple(int(c) - 1 for c in case[1:]): float(v) for case, v in best.items()})
+    return out[0], out[1]
+
+
+def replay(screen: dict, full: dict, start, seed: int, budget: int, restarts: int, refine: int, n_links: int,
+           n_modules: int):
+    """(the answer's full-path cost, assignments screened, refined candidates without a full-path cost). The answer
+    is the best full-path cost among the refined candidates the enumeration solved on the full path: an upper
+    bound when some were not (they ranked below its refinement), NaN when none was. An assignment the screening
+    did not track costs inf."""
+    starts = [tuple(start), *random_assignments(restarts, n_links, n_modules, seed)]
+    _, _, evaluated = neighbourhood_search(starts, n_modules, lambda b: [screen.get(a, np.inf) for a in b], budget)
+    ranked = sorted((a for a, c in evaluated if np.isfinite(c)), key=dict(evaluated).get)[:refine]
+    known = [full[a] for a in ranked if a in full]
+    return (min(known) if known else np.nan), len(evaluated), len(ranked) - len(known)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("run")
+    parser.add_argument("--first-seed", type=int, default=1000)
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--budget", type=int, nargs="+", default=[100, 200, 300])
+    parser.add_argument("--restarts", type=int, default=8)
+    parser.add_argument("--refine", type=int, default=8)
+    parser.add_argument("--start", default="111111", help="the first start's modules (the rounded assignment)")
+    args = parser.parse_args()
+
+    screen, full = costs(Path(args.run))
+    best = min(full.values())
+    n_links, n_modules = len(args.start), 5
+    start = tuple(int(c) - 1 for c in args.start)
+    print(f"{len(screen)} assignments screened, {len(full)} solved on the full path; best full-path cost {best:.6g}")
+    for budget in args.budget:
+        ratios, spent, unknown = [], [], 0
+        for seed in range(args.first_seed, args.first_seed + args.seeds):
+            cost, n, missing = replay(screen, full, start, seed, budget, args.restarts, args.refine, n_links,
+                                      n_modules)
+            ratios.append(cost / best)
+            spent.append(n)
+            unknown += missing
+        r = np.array(ratios)
+        print(f"budget {budget}: answer / best over {args.seeds} seeds: best {np.nanmin(r):.3f} median "
+              f"{np.nanmedian(r):.3f} p90 {np.nanpercentile(r, 90):.3f} worst {np.nanmax(r):.3f}; within 1.10x "
+              f"{int(np.sum(r <= 1.10))}; screened {int(np.median(spent))} (median); refined candidates without a "
+              f"full-path cost {unknown}")
+
+
+if __name__ == "__main__":
+    main()
