@@ -306,11 +306,12 @@ class ToleranceConfig(_Strict):
 
 class SearchConfig(_Strict):
     """How the problem is searched (`designopt.solve.search`): a named preset, its seed, and optionally another
-    number of starts."""
+    number of starts or another spread of their designs (perturb, box)."""
 
     preset: Literal["quick", "default", "thorough", "paper"] = "default"
     seed: Annotated[int, Field(ge=0)] = 0
     starts: Annotated[int, Field(ge=1, le=100_000)] | None = None
+    spread: Literal["perturb", "box"] | None = None
 
 
 class ModuleRow(_Strict):

@@ -22,6 +22,7 @@ from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
 INIT_MODES = ("reach", "ik", "constant")
+SPREADS = ("perturb", "box")  # how seeded starts spread their designs (`initial_guess`)
 
 
 def perturbed_design(problem: DesignProblem, rng: np.random.Generator, scale: float) -> np.ndarray:
@@ -39,12 +40,30 @@ def within_bounds(problem: DesignProblem, q_d: np.ndarray) -> np.ndarray:
     return np.clip(np.asarray(q_d, float), [j.lower for j in joints], [j.upper for j in joints])
 
 
-def random_configuration(problem: DesignProblem, rng: np.random.Generator) -> np.ndarray:
-    """A joint configuration: revolute joints uniform in [-pi/2, pi/2], prismatic at mid-stroke +- 0.2."""
+def box_design(problem: DesignProblem, rng: np.random.Generator) -> np.ndarray:
+    """Design joints drawn from a box the size of the task, not around the configured design: angles uniform over
+    the circle, the placement's position within +- b of its configured value, other lengths uniform in [0, b] m,
+    with b half the path's largest extent (the optimum shrinks the arm toward the path's size); within bounds."""
+    b = 0.5 * float(np.ptp(problem.toolpath.points_W, axis=0).max())
+    placement = {j.name for j in problem.chain.placement_joints}
+    out = []
+    for j in problem.chain.design:
+        if j.kind == "angle":
+            out.append(rng.uniform(-np.pi, np.pi))
+        elif j.name in placement:
+            out.append(j.value + rng.uniform(-b, b))
+        else:
+            out.append(rng.uniform(0.0, b))
+    return within_bounds(problem, np.array(out))
+
+
+def random_configuration(problem: DesignProblem, rng: np.random.Generator, half_range: float = np.pi / 2) -> np.ndarray:
+    """A joint configuration: revolute joints uniform in [-half_range, half_range] (rad), prismatic at mid-stroke
+    +- 0.2 m."""
     out = []
     for j in problem.chain.moving:
         if j.kind == "angle":
-            out.append(rng.uniform(-np.pi / 2, np.pi / 2))
+            out.append(rng.uniform(-half_range, half_range))
         else:
             mid = 0.5 * (max(j.lower, -1.0) + min(j.upper, 1.0))
             out.append(mid + rng.uniform(-0.2, 0.2))
@@ -143,18 +162,24 @@ def _residual_function(payload: bytes):
 
 
 def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik",
-                  design: np.ndarray | None = None) -> InitialGuess:
-    """Start ``index`` of a seeded multistart (seed * 1000 + index). Start 0 keeps the configured design;
-    the others perturb it; ``design`` (if given) is the start design instead. Each start depends only on
-    (seed, index), so starts can be made in any order."""
+                  design: np.ndarray | None = None, spread: str = "perturb") -> InitialGuess:
+    """Start ``index`` of a seeded multistart (seed * 1000 + index). Start 0 keeps the configured design; the
+    others perturb it by ``scale`` (``spread`` perturb: first joints within +-pi/2) or draw it from the task's
+    box (``spread`` box, `box_design`: first joints over the whole circle, so that folded postures are
+    reached); ``design`` (if given) is the start design instead. Each start depends only on (seed, index), so
+    starts can be made in any order."""
     if mode not in INIT_MODES:
         raise ValueError(f"init must be one of {INIT_MODES}, got {mode!r}")
+    if spread not in SPREADS:
+        raise ValueError(f"spread must be one of {SPREADS}, got {spread!r}")
     rng = np.random.default_rng([seed, index])
     if design is not None:
         q_d = within_bounds(problem, design)
+    elif index == 0:
+        q_d = problem.chain.design_values
     else:
-        q_d = problem.chain.design_values if index == 0 else perturbed_design(problem, rng, scale)
-    q0 = random_configuration(problem, rng)
+        q_d = perturbed_design(problem, rng, scale) if spread == "perturb" else box_design(problem, rng)
+    q0 = random_configuration(problem, rng, np.pi / 2 if spread == "perturb" else np.pi)
     if mode == "constant":
         return InitialGuess(q_d=q_d, Q=np.tile(q0, (problem.toolpath.n, 1)), seed=seed * 1000 + index)
     Q = ik_trajectory(problem, q_d, q0)

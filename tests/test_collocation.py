@@ -202,3 +202,39 @@ def test_build_time_is_counted_once_per_built_nlp():
     first, second = (solve(problem, index=i, init="constant", max_iter=50) for i in range(2))
     assert first.raw.build_time_s > 0
     assert second.raw.build_time_s == 0
+
+
+def test_a_box_start_draws_the_design_from_the_tasks_size_and_the_joints_from_the_whole_circle():
+    """``spread`` box (`box_design`): lengths in [0, b] with b half the path's largest extent (0.3 m for the
+    main job's 0.6 m figure-eight), the placement's position within +-b of the configured one, angles over the
+    circle; the first joints of revolute joints over [-pi, pi] (perturb: [-pi/2, pi/2]); start 0 keeps the
+    configured design either way."""
+    from designopt.initial_guess import box_design, initial_guess, random_configuration
+
+    problem = problem_from_config(parse_config({"toolpath": {"kind": "figure_eight", "waypoints": 10}}))
+    chain = problem.chain
+    b = 0.5 * np.ptp(problem.toolpath.points_W, axis=0).max()
+    assert b == pytest.approx(0.3, abs=0.01)  # 10 samples of the 0.6 m figure-eight
+    placement = {j.name for j in chain.placement_joints}
+    configured = chain.design_values
+    draws = np.array([box_design(problem, np.random.default_rng(k)) for k in range(400)])
+    for i, j in enumerate(chain.design):
+        column = draws[:, i]
+        assert np.all((column >= j.lower) & (column <= j.upper))
+        if j.kind == "angle":
+            assert column.min() < -2.5 and column.max() > 2.5  # the whole circle
+        elif j.name in placement:
+            assert np.all(np.abs(column - configured[i]) <= b + 1e-12)
+            assert np.ptp(column) > 1.5 * b
+        else:
+            assert column.min() >= 0.0 and column.max() <= b and np.ptp(column) > 0.8 * b
+    wide = np.array([random_configuration(problem, np.random.default_rng(k), np.pi) for k in range(400)])
+    narrow = np.array([random_configuration(problem, np.random.default_rng(k)) for k in range(400)])
+    assert np.abs(narrow).max() <= np.pi / 2 and np.abs(wide).max() > 3.0
+    for spread in ("perturb", "box"):
+        np.testing.assert_array_equal(initial_guess(problem, 0, 3, 0.3, "constant", spread=spread).q_d, configured)
+    box = initial_guess(problem, 5, 3, 0.3, "constant", spread="box")
+    np.testing.assert_array_equal(box.q_d, initial_guess(problem, 5, 3, 0.3, "constant", spread="box").q_d)
+    assert not np.allclose(box.q_d, initial_guess(problem, 5, 3, 0.3, "constant").q_d)
+    with pytest.raises(ValueError, match="spread"):
+        initial_guess(problem, 1, 0, 0.3, spread="sphere")

@@ -5,6 +5,7 @@ misses, the search finds it."""
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +33,7 @@ from designopt.solve import (
     run_task,
 )
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
+from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import units
 from designopt.toolpaths import figure_eight, subsample
 from designopt.transcriptions import Collocation
@@ -47,6 +49,12 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     changed = search_from_config(parse_config({"search": {"preset": "paper", "seed": 7, "starts": 3}}))
     assert (changed.strategy, changed.seed, changed.starts) == ("multistart", 7, 3)
     assert changed.profile == PRESETS["paper"].profile
+    assert changed.spread == "perturb"
+    boxed = search_from_config(parse_config({"search": {"spread": "box"}}))
+    assert boxed == replace(PRESETS["default"], spread="box")
+    (task, *_) = seeded_tasks(Job("", coarse_problem(problem_from_config(parse_config({})), 10)), "explore",
+                              None, None, boxed, 2)
+    assert task.start.spread == "box"
     assert preset("quick", seed=2) == Search(starts=40, refine=2, seed=2, profile=PRESETS["quick"].profile)
 
 

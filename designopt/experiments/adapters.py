@@ -18,9 +18,10 @@ CASES = {"placement_only": ["placement"], "design_only": ["d", "a", "alpha"],
 
 
 def search_from_config(cfg: Config) -> Search:
-    """The config's search: its preset with the config's seed (and number of starts, when given)."""
+    """The config's search: its preset with the config's seed (and number of starts and spread, when given)."""
     s = cfg.search
-    return preset(s.preset, seed=s.seed, **({"starts": s.starts} if s.starts is not None else {}))
+    given = {k: v for k, v in (("starts", s.starts), ("spread", s.spread)) if v is not None}
+    return preset(s.preset, seed=s.seed, **given)
 
 
 def _dh_only(cfg: Config, what: str) -> None:

@@ -23,7 +23,8 @@ from designopt.transcriptions import Collocation
 class Search:
     """A strategy and its budget. Counts are per problem; iteration caps per solve.
 
-    ``starts`` seeded starts (from ``seed``; perturbation ``perturbation``, joints by ``init``): cold starts on
+    ``starts`` seeded starts (from ``seed``; designs by ``spread``: perturbed by ``perturbation`` or drawn from the
+    task's box, `designopt.initial_guess`; joints by ``init``): cold starts on
     the full path for ``multistart``; for ``coarse_to_fine`` the exploration's starts on ``explore_waypoints`` of
     the path's waypoints (each capped at ``explore_max_iter``), the ``screen`` best distinct of which are re-ranked
     on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no more waypoints), and the
@@ -38,6 +39,7 @@ class Search:
     starts: int = 80
     seed: int = 0
     perturbation: float = 0.3
+    spread: str = "perturb"
     init: str = "ik"
     explore_waypoints: int = 10
     explore_max_iter: int = 250

@@ -18,7 +18,8 @@ from designopt.transcriptions.base import InitialGuess
 @dataclass(frozen=True, eq=False)
 class Seeded:
     """Start ``index`` of a seeded multistart (`designopt.initial_guess`): index 0 keeps the configured design, the
-    others perturb it by ``scale`` (x 0.5 m for lengths, x pi for angles), or ``design`` is the start design;
+    others perturb it by ``scale`` (x 0.5 m for lengths, x pi for angles) or draw it from the task's box (``spread``
+    box), or ``design`` is the start design;
     joints by IK along the path (``init``). Depends only on (seed, index): starts can be made in any order."""
 
     seed: int
@@ -26,13 +27,14 @@ class Seeded:
     scale: float = 0.3
     init: str = "ik"
     design: np.ndarray | None = None
+    spread: str = "perturb"
 
     @property
     def number(self) -> int:
         return self.seed * 1000 + self.index
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
-        return initial_guess(problem, self.index, self.seed, self.scale, self.init, self.design)
+        return initial_guess(problem, self.index, self.seed, self.scale, self.init, self.design, self.spread)
 
 
 @dataclass(frozen=True, eq=False)
