@@ -6,13 +6,13 @@ search's exploration problem (the task on ``--waypoints`` of its waypoints, capp
 search's settings unless given), each compared with the best design known lifted to the same coarse path and
 solved warm there. A start *hits* when it ends within 1.02x / 1.10x of that cost. Hundreds of starts take about
 a minute, where the seed distribution of `search_seeds.py` takes 20 full runs: use this to compare ways of
-starting (``--start box`` draws lengths uniformly in [0, --box-length] m, angles over the whole circle and the
-placement position within +-0.3 m of the configured one, instead of perturbing the configured design by
-``--scale``), then judge the search that uses the better one on the seed distribution.
+starting (``--spread box``: designs from the task's box and first joints over the whole circle,
+`designopt.initial_guess.box_design`, instead of perturbing the configured design by ``--scale``), then judge the
+search that uses the better one on the seed distribution.
 
     .venv/bin/python benchmarks/explore_hits.py [--config configs/milling.yaml]
         [--reference benchmarks/reference/milling_best_known.json] [--first-seed 100] [--seeds 5] [--starts 80]
-        [--scale 0.3 | --start box --box-length 0.3] [--waypoints 10] [--max-iter 250] [--jobs 2]
+        [--scale 0.3 | --spread box] [--waypoints 10] [--max-iter 250] [--jobs 2]
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from designopt.config import load_config
+from designopt.initial_guess import SPREADS
 from designopt.problem import problem_from_config
 from designopt.solution import read_solution_for
 from designopt.solve import Job, Lifted, Seeded, Task, fan_out, preset
@@ -34,21 +35,6 @@ from designopt.transcriptions import Collocation
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def box_design(problem, seed: int, index: int, length: float) -> np.ndarray:
-    """A start design drawn from a box: lengths in [0, length] m, angles in [-pi, pi], placement position within
-    +-0.3 m of the configured one."""
-    rng = np.random.default_rng([seed, index, 99])
-    out = []
-    for j in problem.chain.design:
-        if j.kind == "angle":
-            out.append(rng.uniform(-np.pi, np.pi))
-        elif j.name.startswith("placement"):
-            out.append(j.value + rng.uniform(-0.3, 0.3))
-        else:
-            out.append(rng.uniform(0.0, length))
-    return np.array(out)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--config", default="configs/milling.yaml")
@@ -56,9 +42,8 @@ def main() -> None:
     parser.add_argument("--first-seed", type=int, default=100)
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--starts", type=int, default=80, help="starts per seed")
-    parser.add_argument("--start", choices=("perturb", "box"), default="perturb")
+    parser.add_argument("--spread", choices=SPREADS, default="perturb")
     parser.add_argument("--scale", type=float, default=None, help="perturbation (default: the search's)")
-    parser.add_argument("--box-length", type=float, default=0.3)
     parser.add_argument("--waypoints", type=int, default=None, help="default: the search's explore_waypoints")
     parser.add_argument("--max-iter", type=int, default=None, help="default: the search's explore_max_iter")
     parser.add_argument("--jobs", type=int, default=2)
@@ -80,12 +65,8 @@ def main() -> None:
     profile, hold = solve_setup(job, search, search.profile.capped(args.max_iter or search.explore_max_iter))
     seeds = range(args.first_seed, args.first_seed + args.seeds)
 
-    def start(seed, i):
-        if args.start == "box":
-            return Seeded(seed, i, 0.0, search.init, box_design(problem, seed, i, args.box_length))
-        return Seeded(seed, i, scale, search.init)
-
-    tasks = [Task("hits", "explore", coarse, Collocation(), profile, start(s, i), hold)
+    tasks = [Task("hits", "explore", coarse, Collocation(), profile,
+                  Seeded(s, i, scale, search.init, spread=args.spread), hold)
              for s in seeds for i in range(args.starts)]
     t0 = time.perf_counter()
     done = list(fan_out(tasks, args.jobs))
@@ -93,7 +74,7 @@ def main() -> None:
     ratio = np.array([sol.metrics.design_cost / known if sol.metrics.tracks else np.inf for _, sol in done])
     cpu = sum(sol.raw.solve_time_s for _, sol in done)
     n = len(ratio)
-    how = f"box, lengths <= {args.box_length} m" if args.start == "box" else f"perturbation {scale}"
+    how = "the task's box" if args.spread == "box" else f"perturbation {scale}"
     print(f"{args.config}: {n} starts ({len(seeds)} seeds x {args.starts}; {how}) on {waypoints} waypoints, "
           f"<= {args.max_iter or search.explore_max_iter} iterations; best known there {known:.4g}")
     for level in (1.02, 1.10, 1.30):
