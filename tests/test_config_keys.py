@@ -118,6 +118,7 @@ CHANGES = {
     "search.preset": ({}, {"search": {"preset": "thorough"}}),
     "search.seed": ({}, {"search": {"seed": 3}}),
     "search.starts": ({}, {"search": {"starts": 7}}),
+    "search.spread": ({}, {"search": {"spread": "box"}}),
     "cell.block": (CELL, {"cell": {"block": [0.12, 0.1, 0.05]}}),
     "cell.floor": (CELL, {"cell": {"floor": -1.2}}),
     "cell.clearance": (CELL, {"cell": {"clearance": 0.02}}),
