@@ -191,6 +191,15 @@ MUTATIONS = [
     Mutation("the starts' IK Jacobian scaled (the walk still converges, slower and elsewhere)",
              "designopt/initial_guess.py", "[r, ca.jacobian(r, q), ca.jacobian(r, q_d)]",
              "[r, 2 * ca.jacobian(r, q), ca.jacobian(r, q_d)]", ("tests/test_collocation.py",)),
+    Mutation("the box start sized by the path's whole extent, not half of it",
+             "designopt/initial_guess.py", "b = 0.5 * float(np.ptp(", "b = 1.0 * float(np.ptp(",
+             ("tests/test_collocation.py",)),
+    Mutation("a stage's starts grouped across problems (a unit mixes problems: one NLP built for another's starts)",
+             "designopt/solve/tasks.py", "groups.setdefault((id(t.problem), t.transcription, t.profile), [])",
+             "groups.setdefault((t.transcription, t.profile), [])", ("tests/test_search.py",)),
+    Mutation("the modular neighbourhood search refines its worst screened assignments",
+             "designopt/experiments/modular.py", "key=dict(evaluated).get)[:refine]",
+             "key=lambda a: -dict(evaluated)[a])[:refine]", ("tests/test_modular.py",)),
 ]
 
 
