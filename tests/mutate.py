@@ -129,7 +129,7 @@ MUTATIONS = [
     Mutation("a search option of the config ignored (the seed)", "designopt/experiments/adapters.py",
              "return preset(s.preset, seed=s.seed,", "return preset(s.preset, seed=0,", ("tests/test_config_keys.py",)),
     Mutation("a search option of the config ignored (the starts)", "designopt/experiments/adapters.py",
-             "**({\"starts\": s.starts} if s.starts is not None else {})", "**{}",
+             '(("starts", s.starts), ("spread", s.spread))', '(("spread", s.spread),)',
              ("tests/test_config_keys.py",)),
     Mutation("modular rounding reads the configured design, not the solved one", "designopt/experiments/modular.py",
              "assignment = nearest_modules(continuous.problem.chain, continuous.raw.q_d, catalogue)",
