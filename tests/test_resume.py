@@ -132,19 +132,23 @@ def test_waypoints_resumes(tmp_path):
 def test_modular_resumes(tmp_path):
     config = _setup(tmp_path, {"search": {"preset": "paper", "starts": 2}})
     out, run = tmp_path / "r", tmp_path / "r" / "modular" / "k"
-    before = kill_part_way(["modular", str(config), "--out", str(out), "--name", "k"], run / "summary.csv")
+    args = ["modular", str(config), "--out", str(out), "--name", "k", "--budget", "12"]
+    before = kill_part_way(args, run / "summary.csv")
     assert len(before) < 9, "the run was not killed part-way"
     _lose_first_file(run, before)
-    result = runner.invoke(app, ["modular", str(config), "--out", str(out), "--name", "k", "--resume"])
+    result = runner.invoke(app, [*args, "--resume"])
     after = read_summary(run / "summary.csv")
     solves = {(c, "start", m, "RRRRRR", s) for c, m in (("continuous", "to"), ("fk", "fk"),
                                                          ("continuous_modular", "to"), ("modular", "to"))
               for s in range(2)}
     rounded = {k for k in after[KEY].itertuples(index=False, name=None) if k[0] == "rounded"}
     assert len(rounded) == 1
-    searched = {k for k in after[KEY].itertuples(index=False, name=None) if k[0].startswith("nb-")}
-    assert len(searched) % 2 == 0 and len(searched) <= 2 * 48  # each assignment tried: 2 starts
-    check_resumed(run, before, solves | rounded | searched, result)
+    keys = set(after[KEY].itertuples(index=False, name=None))
+    screened = {k for k in keys if k[0].startswith("sc-")}
+    assert len(screened) == 3 * 12  # the budget's 12 assignments, 3 screening starts each
+    searched = {k for k in keys if k[0].startswith("nb-")}
+    assert len(searched) % 2 == 0 and len(searched) <= 2 * 8  # the best screened, 2 starts each
+    check_resumed(run, before, solves | rounded | screened | searched, result)
     assert len(pd.read_csv(run / "table.csv")) == 6
 
 
