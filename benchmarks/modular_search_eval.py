@@ -22,9 +22,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from designopt.experiments.modular import random_assignments
-from designopt.modular import neighbourhood_search
+from designopt.config import load_config
+from designopt.experiments.modular import catalogue_from_config
+from designopt.modular import screened_candidates
 from designopt.tables import COARSE_STAGES
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def costs(run: Path) -> tuple[dict, dict]:
@@ -39,17 +42,15 @@ def costs(run: Path) -> tuple[dict, dict]:
     return out[0], out[1]
 
 
-def replay(screen: dict, full: dict, start, seed: int, budget: int, restarts: int, refine: int, n_links: int,
-           n_modules: int):
+def replay(screen: dict, full: dict, start, seed: int, budget: int, restarts: int, refine: int, n_modules: int):
     """(the best screening cost it found, the answer's full-path cost, assignments screened, refined candidates
     without a full-path cost). The answer is the best full-path cost among the refined candidates that the
     enumeration solved on the full path: an upper bound when some were not (they ranked below its refinement), NaN
     when none was. An assignment the screening did not track costs inf."""
-    starts = [tuple(start), *random_assignments(restarts, n_links, n_modules, seed)]
-    _, found, evaluated = neighbourhood_search(starts, n_modules, lambda b: [screen.get(a, np.inf) for a in b],
-                                               budget)
-    ranked = sorted((a for a, c in evaluated if np.isfinite(c)), key=dict(evaluated).get)[:refine]
+    ranked, evaluated = screened_candidates(start, n_modules, lambda b: [screen.get(a, np.inf) for a in b], budget,
+                                            restarts, refine, seed)
     known = [full[a] for a in ranked if a in full]
+    found = min(c for _, c in evaluated)
     return found, (min(known) if known else np.nan), len(evaluated), len(ranked) - len(known)
 
 
@@ -62,6 +63,7 @@ def _quantiles(r) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("run")
+    parser.add_argument("--config", default=str(ROOT / "configs" / "modular.yaml"), help="the enumeration's catalogue")
     parser.add_argument("--first-seed", type=int, default=1000)
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--budget", type=int, nargs="+", default=[100, 200, 300])
@@ -74,13 +76,13 @@ def main() -> None:
     screen, full = costs(Path(args.run))
     best_screen = min(screen.values())
     best = min(full.values()) if full else np.nan
-    n_links, n_modules = len(args.start), 5
+    n_modules = len(catalogue_from_config(load_config(args.config)).modules)
     start = tuple(int(c) - 1 for c in args.start)
     print(f"{len(screen)} assignments track on the screening (best {best_screen:.6g}), {len(full)} solved on the full "
           f"path (best {best:.6g}); seeds {args.first_seed}-{args.first_seed + args.seeds - 1}")
     for budget in args.budget:
         found, answer, spent, unknown = zip(*[replay(screen, full, start, seed, budget, args.restarts, args.refine,
-                                                     n_links, n_modules)
+                                                     n_modules)
                                               for seed in range(args.first_seed, args.first_seed + args.seeds)],
                                             strict=True)
         print(f"budget {budget} (screened {int(np.median(spent))} median): best screened found / best screening "

@@ -124,3 +124,21 @@ def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate
             current, cost = around[k], values[k]
     best = min(seen, key=seen.get)
     return list(best), seen[best], list(seen.items())
+
+
+def random_assignments(count: int, n_links: int, n_modules: int, seed: int) -> list[tuple[int, ...]]:
+    """``count`` module assignments drawn uniformly, from ``seed`` alone."""
+    rng = np.random.default_rng([seed, 25])
+    return [tuple(int(k) for k in rng.integers(0, n_modules, n_links)) for _ in range(count)]
+
+
+def screened_candidates(start: tuple[int, ...], n_modules: int, screen, budget: int, restarts: int, refine: int,
+                        seed: int):
+    """The coarse half of the modular search: `neighbourhood_search` on screening costs ``screen(assignments)``
+    from ``start`` (the rounded assignment) and ``restarts`` seeded random assignments, within ``budget``. Returns
+    (the ``refine`` best screened assignments that track, best first; every (assignment, screening cost) in the
+    order screened)."""
+    starts = [tuple(start), *random_assignments(restarts, len(start), n_modules, seed)]
+    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget)
+    ranked = sorted((a for a, c in evaluated if np.isfinite(c)), key=dict(evaluated).get)[:refine]
+    return ranked, evaluated

@@ -198,7 +198,7 @@ MUTATIONS = [
              "designopt/solve/tasks.py", "groups.setdefault((id(t.problem), t.transcription, t.profile), [])",
              "groups.setdefault((t.transcription, t.profile), [])", ("tests/test_search.py",)),
     Mutation("the modular neighbourhood search refines its worst screened assignments",
-             "designopt/experiments/modular.py", "key=dict(evaluated).get)[:refine]",
+             "designopt/modular.py", "key=dict(evaluated).get)[:refine]",
              "key=lambda a: -dict(evaluated)[a])[:refine]", ("tests/test_modular.py",)),
 ]
 

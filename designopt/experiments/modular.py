@@ -36,6 +36,7 @@ from designopt.modular import (
     modular_cost,
     nearest_modules,
     neighbourhood_search,
+    screened_candidates,
 )
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
@@ -200,23 +201,15 @@ def module_screen(search: Search) -> Search:
     return preset("paper", starts=3, seed=search.seed, init="reach", profile=profile)
 
 
-def random_assignments(count: int, n_links: int, n_modules: int, seed: int) -> list[tuple[int, ...]]:
-    """``count`` module assignments drawn uniformly, from ``seed`` alone."""
-    rng = np.random.default_rng([seed, 25])
-    return [tuple(int(k) for k in rng.integers(0, n_modules, n_links)) for _ in range(count)]
-
-
 def _module_search(setup, base, catalogue, placement, rounded, modular, budget, restarts=NEIGHBOURHOOD_RESTARTS,
                    refine=NEIGHBOURHOOD_REFINE):
     """The neighbourhood stage: a local search over assignments on screening costs, from the rounded assignment
     and ``restarts`` seeded random ones, within ``budget`` screened assignments; then the ``refine`` best screened
     re-solved on the full path like the modular stage. Returns (best assignment, its solution, assignments
     screened); never worse than the rounded assignment's re-solve ``modular``."""
-    n_modules = len(catalogue.modules)
     screen = ModuleCosts(setup, base, catalogue, placement, "sc-", module_screen(setup.search), SCREEN_WAYPOINTS)
-    starts = [tuple(rounded), *random_assignments(restarts, base.chain.n_links, n_modules, setup.search.seed)]
-    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget)
-    ranked = sorted((a for a, c in evaluated if np.isfinite(c)), key=dict(evaluated).get)[:refine]
+    ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget, restarts, refine,
+                                            setup.search.seed)
     full = ModuleCosts(setup, base, catalogue, placement, "nb-")
     full.best[tuple(rounded)] = modular  # already solved: the modular stage
     full(ranked)
