@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from designopt.problem import DesignProblem
-from designopt.transcriptions.degeneracy import held_at_multiples_of_pi
+from designopt.transcriptions.degeneracy import held_at_multiples_of_pi, tracking_jacobian
 
 
 class DegenerateWatch:
@@ -26,6 +26,7 @@ class DegenerateWatch:
         self.problem, self.patience, self.tol = problem, patience, tol
         self.angle = np.array([j.kind == "angle" and j.lower < j.upper for j in problem.chain.design], dtype=bool)
         self._verdicts: dict[tuple[bool, ...], bool] = {}
+        self._jacobian = None  # the tracking Jacobian, built at the first verdict and reused by every other one
         self.reset()
 
     def reset(self) -> None:
@@ -37,7 +38,9 @@ class DegenerateWatch:
             return False
         key = tuple(near)
         if key not in self._verdicts:  # the analysis is exact per set of near-pi angles: once per set
-            self._verdicts[key] = held_at_multiples_of_pi(self.problem, q_d, self.tol) is not None
+            if self._jacobian is None:
+                self._jacobian = tracking_jacobian(self.problem)
+            self._verdicts[key] = held_at_multiples_of_pi(self.problem, q_d, self.tol, self._jacobian) is not None
         return self._verdicts[key]
 
     def observe(self, q_d: np.ndarray, iterations: int = 1) -> bool:

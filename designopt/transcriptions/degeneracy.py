@@ -45,16 +45,18 @@ def tracking_jacobian(problem: DesignProblem) -> ca.Function:
     return ca.Function("drows_dq", [q, q_d], [ca.jacobian(ca.vertcat(p_W, z_W), q)])
 
 
-def q_independent_rows(problem: DesignProblem, samples: int = 4, seed: int = 0, tol: float = 1e-9) -> np.ndarray:
+def q_independent_rows(problem: DesignProblem, samples: int = 4, seed: int = 0, tol: float = 1e-9,
+                       jacobian: ca.Function | None = None) -> np.ndarray:
     """The hard tracking rows (0-2 tool position in W, 3-5 tool axis z_W) that do not depend on the moving
     joints for any design within the design joints' bounds and whose target is the same at every tracked
     waypoint: holding such a row at one waypoint holds it at all of them.
 
     Independence is exact when the expression does not contain the joints (a PPP gantry's axis); otherwise it is
     judged on ``samples`` random (q, q_d) within bounds (a held twist of pi leaves sin(pi) = 1e-16 in the
-    expression): every |d row / dq| below ``tol``."""
+    expression): every |d row / dq| below ``tol``. ``jacobian``: `tracking_jacobian` of this problem or of one
+    that differs from it only in its joints' bounds (a held problem's is its unheld problem's), to build it once."""
     chain, tp = problem.chain, problem.toolpath
-    jacobian = tracking_jacobian(problem)
+    jacobian = tracking_jacobian(problem) if jacobian is None else jacobian
     depends = set(jacobian.sparsity_out(0).get_triplet()[0])  # rows whose expression contains q at all
     rng = np.random.default_rng(seed)
     draws = [(_sample(chain.moving, rng), _sample(chain.design, rng)) for _ in range(samples)]
@@ -69,11 +71,13 @@ def q_independent_rows(problem: DesignProblem, samples: int = 4, seed: int = 0, 
     return np.array(out, dtype=int)
 
 
-def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3) -> tuple[DesignProblem, np.ndarray] | None:
+def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3,
+                            jacobian: ca.Function | None = None) -> tuple[DesignProblem, np.ndarray] | None:
     """``problem`` with every angle design joint within ``tol`` (rad) of a multiple of pi held there (its bounds
     set to that value), and the design with those joints snapped; None when no joint not yet held is that close,
     or when holding them frees no tracking row from the joints that the problem did not already hold once.
-    A held joint stays a design joint: the solution's layout does not change, IPOPT treats it as fixed."""
+    A held joint stays a design joint: the solution's layout does not change, IPOPT treats it as fixed.
+    ``jacobian``: the problem's `tracking_jacobian`, for a caller that asks many times (built here otherwise)."""
     q_d = np.array(q_d, dtype=float)
     joints = list(problem.chain.joints)
     design_index = [i for i, j in enumerate(joints) if j.role is Role.DESIGN]
@@ -90,6 +94,7 @@ def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3) -> t
     if not held:
         return None
     candidate = replace(problem, chain=replace(problem.chain, joints=tuple(joints)))
-    if len(q_independent_rows(candidate)) <= len(q_independent_rows(problem)):
+    jacobian = tracking_jacobian(problem) if jacobian is None else jacobian  # held joints stay inputs: one function
+    if len(q_independent_rows(candidate, jacobian=jacobian)) <= len(q_independent_rows(problem, jacobian=jacobian)):
         return None  # e.g. a PPP gantry, whose axis rows never depended on its joints: nothing degenerates here
     return candidate, q_d
