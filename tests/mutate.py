@@ -108,7 +108,7 @@ MUTATIONS = [
              "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e-12:",
              "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e12:"),
     Mutation("a gantry's own once-only rows count as degenerate", "designopt/transcriptions/degeneracy.py",
-             "if len(q_independent_rows(candidate, jacobian=jacobian)) <= len(q_independent_rows(problem, jacobian=jacobian)):",
+             "if len(q_independent_rows(candidate, jacobian=jacobian)) <= before:",
              "if len(q_independent_rows(candidate, jacobian=jacobian)) == 0:"),
     Mutation("a stalled solve is continued without holding its angles", "designopt/solve/strategies/continuation.py",
              "more = solve_guess(problem, task.transcription,", "more = solve_guess(task.problem, task.transcription,"),

@@ -95,6 +95,7 @@ def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3,
         return None
     candidate = replace(problem, chain=replace(problem.chain, joints=tuple(joints)))
     jacobian = tracking_jacobian(problem) if jacobian is None else jacobian  # held joints stay inputs: one function
-    if len(q_independent_rows(candidate, jacobian=jacobian)) <= len(q_independent_rows(problem, jacobian=jacobian)):
+    before = len(q_independent_rows(problem, jacobian=jacobian))
+    if len(q_independent_rows(candidate, jacobian=jacobian)) <= before:
         return None  # e.g. a PPP gantry, whose axis rows never depended on its joints: nothing degenerates here
     return candidate, q_d
