@@ -336,6 +336,8 @@ def modular(
     weight: Annotated[float, typer.Option("--weight", min=0.0, help="Weight of L_mod in the objective.")] = 1.0e-3,
     budget: Annotated[int, typer.Option("--budget", min=0, help="Module assignments the neighbourhood search may "
                                                                 "screen (0: no neighbourhood search).")] = 300,
+    refine: Annotated[int, typer.Option("--refine", min=1, help="Best screened assignments the neighbourhood "
+                                                                "search searches on the full path.")] = 8,
 ):
     """Modular design: continuous TO with L_mod, round links to modules, re-solve placement, search neighbouring
     assignments (+ FK, plain TO)."""
@@ -344,7 +346,7 @@ def modular(
     cfg = load(config)
     with Bar("modular") as bar:
         result = run_modular(cfg, out_dir, name, bar, resume=resume, jobs=jobs, weight=weight,
-                             neighbourhood_budget=budget)
+                             neighbourhood_budget=budget, neighbourhood_refine=refine)
     show(_frame_table(result.table, "modular design: best tracking start per stage"))
     out.print(f"results: {result.directory.path}")
 

@@ -116,7 +116,7 @@ def test_modular_command_writes_every_stage(tmp_path):
                                       "placement": {"xyz": [0.45, 0.0, -0.2]},
                                       "search": {"preset": "paper", "starts": 1}}))
     result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path / "r"), "--name", "t",
-                                      "--budget", "30"])
+                                      "--budget", "30", "--refine", "3"])
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "modular" / "t"
     summary = pd.read_csv(run / "summary.csv")
@@ -124,17 +124,20 @@ def test_modular_command_writes_every_stage(tmp_path):
     assert {"continuous", "continuous_modular", "rounded", "modular", "fk"} <= stages
     screened = {c for c in stages if c.startswith("sc-")}  # the neighbourhood search's screened candidates
     assert len(screened) == 30  # the budget, all spent: eight random restarts are more than 30 can finish
-    size = summary.groupby(summary["case"].str[:3])["n_variables"].agg(set)
-    assert len(size["sc-"]) == 1 and max(size["sc-"]) < min(size["nb-"])  # screened on 10 of the 12 waypoints
-    refined = {c for c in stages if c.startswith("nb-")}  # the best screened, re-solved on the full path
-    assert 1 <= len(refined) <= 8
+    size = summary.groupby([summary["case"].str[:3], "stage"])["n_variables"].agg(set)
+    assert len(size["sc-", "start"]) == 1  # screened on 10 of the 12 waypoints, searched (default) on all 12
+    assert max(size["sc-", "start"]) < min(size["nb-", "refine"])
+    refined = {c for c in stages if c.startswith("nb-")}  # the best screened, searched on the full path
+    assert 1 <= len(refined) <= 3
+    nb = summary[summary["case"].isin(refined)]
+    assert {"explore", "refine"} <= set(nb["stage"])  # coarse to fine (no screen on 12 waypoints), not the paper's
     rows = summary[summary["case"].isin(screened) & (summary["tracks"].astype(str) == "True")]
     costs = rows.groupby("case")["design_cost"].min()
-    eighth = costs.sort_values().iloc[min(8, len(costs)) - 1]
+    third = costs.sort_values().iloc[min(3, len(costs)) - 1]
     table = pd.read_csv(run / "table.csv").set_index("stage")
     rounded = table.loc["modular", "modules"].replace("m", "").replace(" ", "")  # solved already: not again
-    assert all(costs["sc-" + c[3:]] <= eighth for c in refined)  # the best screened (ties either way)
-    assert len(refined | {f"nb-{rounded}"}) >= min(8, len(costs))
+    assert all(costs["sc-" + c[3:]] <= third for c in refined)  # the best screened (ties either way)
+    assert len(refined | {f"nb-{rounded}"}) >= min(3, len(costs))
     table = pd.read_csv(run / "table.csv").set_index("stage")
     # the search starts from the rounded assignment and never ends worse than its re-solve
     assert table.loc["neighbourhood", "design_cost"] <= table.loc["modular", "design_cost"] * (1 + 1e-9)

@@ -132,7 +132,7 @@ def test_waypoints_resumes(tmp_path):
 def test_modular_resumes(tmp_path):
     config = _setup(tmp_path, {"search": {"preset": "paper", "starts": 2}})
     out, run = tmp_path / "r", tmp_path / "r" / "modular" / "k"
-    args = ["modular", str(config), "--out", str(out), "--name", "k", "--budget", "12"]
+    args = ["modular", str(config), "--out", str(out), "--name", "k", "--budget", "12", "--refine", "2"]
     before = kill_part_way(args, run / "summary.csv")
     assert len(before) < 9, "the run was not killed part-way"
     _lose_first_file(run, before)
@@ -147,7 +147,9 @@ def test_modular_resumes(tmp_path):
     screened = {k for k in keys if k[0].startswith("sc-")}
     assert len(screened) == 3 * 12  # the budget's 12 assignments, 3 screening starts each
     searched = {k for k in keys if k[0].startswith("nb-")}
-    assert len(searched) % 2 == 0 and len(searched) <= 2 * 8  # the best screened, 2 starts each
+    refined = {k for k in searched if k[1] == "refine"}  # the best screened, searched on the full path
+    assert 1 <= len({k[0] for k in refined}) <= 2  # --refine 2
+    assert {k[1] for k in searched} == {"explore", "refine"}  # the default search (no screen on 12 waypoints)
     check_resumed(run, before, solves | rounded | screened | searched, result)
     assert len(pd.read_csv(run / "table.csv")) == 6
 
