@@ -38,6 +38,10 @@ _show_warning = warnings.showwarning
 def _group() -> None:
     """Design a robot and its cell in one trajectory optimization."""
     warnings.showwarning = _warn
+    # joblib's process pool (loky) replaces a worker whose memory grew by 300 MB (the NLPs it keeps built) and
+    # says so as "a memory leak"; the worker's tasks are not lost and the results are the same.
+    warnings.filterwarnings("ignore", message="A worker stopped while some jobs were given to the executor",
+                            category=UserWarning)
 
 
 def fail(message: str) -> None:
