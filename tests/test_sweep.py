@@ -130,6 +130,33 @@ def test_failed_solves_are_rows(tmp_path, capfd):
     assert "overconstrained" not in captured.out + captured.err
 
 
+def test_held_joints_solve_without_casadis_warning(tmp_path, capfd):
+    """A 2-joint arm on a few waypoints has a few more variables than equalities; with more design joints than
+    that held (lbx == ubx, as the hold of a degenerate design does) CasADi counts the held joints as equalities
+    and warns that the NLP is overconstrained, but IPOPT removes them and solves: the solve runs (no
+    Not_Enough_Degrees_Of_Freedom), and the warning does not reach the terminal."""
+    from dataclasses import replace
+
+    from designopt.experiments.sweep import structure_config
+    from designopt.initial_guess import initial_guess
+    from designopt.problem import problem_from_config
+    from designopt.solve import local
+    from designopt.transcriptions.collocation import Collocation
+
+    problem = problem_from_config(structure_config(load_config(small_config(tmp_path)), "RR"))
+    built, _, _ = local.prepared(problem, Collocation(), SolverProfile(max_iter=3))
+    spare = built.nlp.n_variables - built.nlp.n_equalities
+    design = [i for i, j in enumerate(problem.chain.joints) if j.role.name == "DESIGN"][: spare + 2]
+    joints = [replace(j, lower=j.value, upper=j.value) if i in design else j
+              for i, j in enumerate(problem.chain.joints)]
+    held = replace(problem, chain=replace(problem.chain, joints=tuple(joints)))
+    built, solver, _ = local.prepared(held, Collocation(), SolverProfile(max_iter=3))
+    assert built.nlp.n_equalities <= built.nlp.n_variables < built.nlp.n_equalities + len(design)
+    outcome = solver.solve(built.pack(initial_guess(held, 0, 0, 0.3, "ik")))
+    assert outcome.iterations > 0 and not outcome.status.startswith("Not_Enough"), outcome.status
+    assert "overconstrained" not in "".join(capfd.readouterr())
+
+
 def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 

@@ -10,6 +10,9 @@ their bound 0 and a push of 1 cm changes the problem. Observers (`designopt.solv
 
 from __future__ import annotations
 
+import contextlib
+import io
+import sys
 import time
 
 import casadi as ca
@@ -99,6 +102,11 @@ class PreparedIpopt:
             opts["iteration_callback"] = self._callback
             opts["iteration_callback_step"] = OBSERVE_EVERY
         self.solver = ca.nlpsol(nlp.name, "ipopt", problem, opts)
+        # CasADi counts fixed variables (held design joints, lbx == ubx) as equalities and warns on the terminal at
+        # every solve when that count exceeds the variables, although IPOPT removes them and solves (a held planar
+        # arm's tracking rows are redundant, not too many: the sweep's held RR, RP, PR on 10 waypoints converge).
+        fixed = int(np.sum(nlp.lbx == nlp.ubx))
+        self._casadi_warns = nlp.n_equalities <= nlp.n_variables < nlp.n_equalities + fixed
         self.prepare_time_s = time.perf_counter() - t0
 
     def solve(self, x0: np.ndarray) -> Outcome:
@@ -112,7 +120,13 @@ class PreparedIpopt:
             # terminal, once per solve (a sweep's one-joint structures: hundreds of lines).
             return Outcome(x0, float("nan"), "Not_Enough_Degrees_Of_Freedom", False, 0, 0.0)
         t0 = time.perf_counter()
-        sol = self.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+        if self._casadi_warns:
+            with contextlib.redirect_stderr(io.StringIO()) as said:  # CasADi writes through Python's stderr
+                sol = self.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+            sys.stderr.write("".join(line for line in said.getvalue().splitlines(keepends=True)
+                                     if "NLP is overconstrained" not in line))
+        else:
+            sol = self.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
         wall = time.perf_counter() - t0
         stats = self.solver.stats()
         status = str(stats.get("return_status", "unknown"))
