@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import sys
+import time
 import warnings
 from pathlib import Path
 from typing import Annotated
@@ -182,8 +183,13 @@ def check(config: Annotated[Path, typer.Argument(help="YAML config (see configs/
     out.print(f"a run searches it by {s.search}; nothing was solved")
 
 
+# Seconds between two plain progress lines when stderr is not a terminal (a log file, CI): rich draws no bar there.
+PLAIN_PROGRESS_EVERY_S = 60.0
+
+
 class Bar:
-    """A rich progress bar that is an experiment's `Progress`: solves planned, solves done, how many track."""
+    """A rich progress bar that is an experiment's `Progress`: solves planned, solves done, how many track. When
+    stderr is not a terminal, a plain line every `PLAIN_PROGRESS_EVERY_S` seconds instead."""
 
     def __init__(self, label: str):
         from rich.progress import (
@@ -199,6 +205,7 @@ class Bar:
         self.bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                             TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn(), console=err, transient=True)
         self.task = self.bar.add_task(label, total=0)
+        self.plain, self.last_line = not err.is_terminal, time.monotonic()
 
     def __enter__(self):
         self.bar.__enter__()
@@ -215,6 +222,11 @@ class Bar:
         self.failed += not solution.metrics.tracks
         where = " ".join(x for x in (task.case, task.stage, task.problem.chain.structure) if x)
         self.bar.update(self.task, advance=1, description=f"{self.label} {where}: {self.failed} not tracking")
+        if self.plain and time.monotonic() - self.last_line >= PLAIN_PROGRESS_EVERY_S:
+            self.last_line = time.monotonic()
+            t = self.bar.tasks[0]
+            err.print(f"{self.label}: {t.completed:.0f} of {t.total:.0f} solves planned so far, {self.failed} not "
+                      f"tracking, {t.elapsed:.0f} s", highlight=False)
 
 
 def _frame_table(frame, title: str) -> Table:

@@ -51,6 +51,21 @@ def test_run_writes_the_run_directory(finished_run):
     assert (summary["stiffness_revolute"] == 1.0).all()
 
 
+def test_progress_is_plain_lines_when_not_on_a_terminal(tmp_path, monkeypatch):
+    """In a log file or CI (the test runner's output is not a terminal) rich draws no bar: a line now and then
+    says how far the work is (here after every solve)."""
+    import cli.main
+
+    monkeypatch.setattr(cli.main, "PLAIN_PROGRESS_EVERY_S", 0.0)
+    config = tmp_path / "gantry.yaml"
+    config.write_text(yaml.safe_dump(gantry_config(design=["a", "x", "z"], search={"preset": "quick", "starts": 3})))
+    result = runner.invoke(app, ["run", str(config), "--out", str(tmp_path / "r"), "--jobs", "1", "--no-figures"])
+    assert result.exit_code == 0, result.output
+    lines = re.findall(r": (\d+) of (\d+) solves planned so far, (\d+) not tracking", result.output)
+    assert len(lines) >= 4 and [int(done) for done, _, _ in lines] == list(range(1, len(lines) + 1))
+    assert all(int(done) <= int(total) for done, total, _ in lines)
+
+
 def test_view_command_writes_one_offline_file(finished_run, tmp_path):
     _, run = finished_run
     result = runner.invoke(app, ["view", str(run / "best.json"), "--out", str(tmp_path / "v.html"), "--frames", "5"])
