@@ -105,8 +105,7 @@ class PreparedIpopt:
         # CasADi counts fixed variables (held design joints, lbx == ubx) as equalities and warns on the terminal at
         # every solve when that count exceeds the variables, although IPOPT removes them and solves (a held planar
         # arm's tracking rows are redundant, not too many: the sweep's held RR, RP, PR on 10 waypoints converge).
-        fixed = int(np.sum(nlp.lbx == nlp.ubx))
-        self._casadi_warns = nlp.n_equalities <= nlp.n_variables < nlp.n_equalities + fixed
+        self._casadi_warns = nlp.n_equalities + int(np.sum(nlp.lbx == nlp.ubx)) > nlp.n_variables
         self.prepare_time_s = time.perf_counter() - t0
 
     def solve(self, x0: np.ndarray) -> Outcome:
@@ -120,13 +119,13 @@ class PreparedIpopt:
             # terminal, once per solve (a sweep's one-joint structures: hundreds of lines).
             return Outcome(x0, float("nan"), "Not_Enough_Degrees_Of_Freedom", False, 0, 0.0)
         t0 = time.perf_counter()
-        if self._casadi_warns:
-            with contextlib.redirect_stderr(io.StringIO()) as said:  # CasADi writes through Python's stderr
-                sol = self.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+        # CasADi writes its warnings through Python's stderr: caught only where it would warn, the rest passed on
+        quiet = contextlib.redirect_stderr(io.StringIO()) if self._casadi_warns else contextlib.nullcontext()
+        with quiet as said:
+            sol = self.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+        if said is not None:
             sys.stderr.write("".join(line for line in said.getvalue().splitlines(keepends=True)
                                      if "NLP is overconstrained" not in line))
-        else:
-            sol = self.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
         wall = time.perf_counter() - t0
         stats = self.solver.stats()
         status = str(stats.get("return_status", "unknown"))
