@@ -204,6 +204,9 @@ MUTATIONS = [
              "designopt/solve/backends/ipopt.py",
              "self._casadi_warns = nlp.n_equalities + int(np.sum(nlp.lbx == nlp.ubx)) > nlp.n_variables",
              "self._casadi_warns = False", ("tests/test_sweep.py",)),
+    Mutation("nlpsol builds the reverse derivative of the whole NLP at set-up (most of a cell's build)",
+             "designopt/solve/backends/ipopt.py", '"ipopt.acceptable_iter": 10, "no_nlp_grad": True}',
+             '"ipopt.acceptable_iter": 10}', ("tests/test_transcriptions.py",)),
 ]
 
 

@@ -65,6 +65,19 @@ def test_structured_derivatives_equal_casadi(method, rng):
                 np.testing.assert_allclose(np.array(ca.DM(a)), np.array(ca.DM(b)), rtol=1e-9, atol=1e-9)
 
 
+@pytest.mark.parametrize("method", METHODS)
+def test_the_solver_derives_nothing_of_the_whole_nlp(method, gantry_problem):
+    """nlpsol is given every derivative IPOPT asks for, and asked for no reverse derivative of the whole NLP
+    ("nlp_grad", which it would build at set-up only to compute lam_p of an NLP without parameters): on a
+    production cell that derivative was most of the build. The solve still returns IPOPT's own multipliers."""
+    _, solver, _ = prepared(gantry_problem, transcription_named(method), SolverProfile(compile="none"))
+    assert not solver.solver.has_function("nlp_grad")
+    nlp = solver.nlp
+    x0 = np.clip(np.zeros(nlp.n_variables), nlp.lbx, nlp.ubx)
+    out = solver.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+    assert np.all(np.isfinite(np.array(out["lam_g"]))) and np.any(np.array(out["lam_g"]) != 0)
+
+
 @pytest.fixture(scope="module")
 def solved():
     cfg = parse_config({"toolpath": {"kind": "circle", "radius": 0.08, "waypoints": 10},

@@ -22,8 +22,11 @@ from designopt.solve.backends.base import Outcome
 from designopt.solve.observers import make_observers
 from designopt.transcriptions.nlp import NLP
 
+# no_nlp_grad: nlpsol otherwise builds, at set-up, the reverse derivative of the whole NLP ("nlp_grad"), which it
+# needs only to compute lam_p (our NLPs have no parameters) or multipliers IPOPT returns itself: 1.8 s of the pocket
+# cell's warm build, 0.16 s of the main job's (benchmarks/speed_table.py --build).
 BASE_OPTIONS = {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False, "ipopt.tol": 1e-8,
-                "ipopt.acceptable_tol": 1e-6, "ipopt.acceptable_iter": 10}
+                "ipopt.acceptable_tol": 1e-6, "ipopt.acceptable_iter": 10, "no_nlp_grad": True}
 WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6, "ipopt.bound_frac": 1e-6}
 # IPOPT stops these before its first iteration, and the iteration count it reports is then stale.
 PRE_ITERATION_STATUSES = {"Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition", "Invalid_Option"}
