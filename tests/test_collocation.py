@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 from dataclasses import replace
 
 import casadi as ca
@@ -15,6 +18,7 @@ from designopt.problem import problem_from_config
 from designopt.solve import SolverProfile
 from designopt.solve.local import prepared
 from designopt.transcriptions import Collocation
+from designopt.transcriptions.compiled import compiled
 from designopt.transcriptions.trajectory import hermite_acceleration_integral, hermite_midpoint
 
 
@@ -100,6 +104,32 @@ def test_compiled_block_gives_the_same_hessian(rng, tmp_path, monkeypatch):
     Ha = np.array(ca.DM(fa(x, [], 1.0, lam_g)))
     Hb = np.array(ca.DM(fb(x, [], 1.0, lam_g)))
     np.testing.assert_allclose(Ha, Hb, rtol=1e-12, atol=1e-12)
+
+
+BLOCK = """
+import casadi as ca
+x = ca.SX.sym("x", 3)
+def block(expr):
+    return ca.Function("blk", [x], [expr(x) * ca.sumsqr(x)])
+"""
+
+
+def test_compile_cache_is_keyed_by_the_function_in_any_process(tmp_path, monkeypatch):
+    """Two functions of one name get two libraries, each computing its own function; the same function built
+    anew (here, and in another process) finds its library instead of compiling again."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    scope = {}
+    exec(BLOCK, scope)
+    x0 = np.array([0.3, -1.2, 0.7])
+    for expr in (ca.sin, ca.cos):
+        fn = scope["block"](expr)
+        np.testing.assert_allclose(np.array(compiled(fn, "O0")(x0)), np.array(fn(x0)), rtol=1e-14)
+    libraries = sorted(tmp_path.glob("*.so"))
+    assert len(libraries) == 2
+    compiled(scope["block"](ca.sin), "O0")
+    script = BLOCK + "from designopt.transcriptions.compiled import compiled\ncompiled(block(ca.sin), 'O0')\n"
+    subprocess.run([sys.executable, "-c", script], check=True, env={**os.environ, "DESIGNOPT_CACHE": str(tmp_path)})
+    assert sorted(tmp_path.glob("*.so")) == libraries
 
 
 def test_ik_start_tracks_a_reachable_path():

@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 
 from designopt.transcriptions.compiled import compiled
-from designopt.transcriptions.hessian import per_point
+from designopt.transcriptions.hessian import ccs_sparsity, per_point
 
 
 def block_jacobian_function(terms: ca.Function, compile_mode: str) -> tuple[ca.Function, np.ndarray, np.ndarray]:
@@ -56,7 +56,7 @@ def assemble_jacobian(x, g, g_of: ca.Function,
     keys = all_cols[order] * n_g + all_rows[order]
     if np.any(keys[1:] == keys[:-1]):
         raise ValueError("two blocks claim the same constraint row")
-    sp = ca.Sparsity.triplet(n_g, n_x, all_rows[order].tolist(), all_cols[order].tolist())
+    sp = ccs_sparsity(n_g, n_x, all_rows[order], all_cols[order])
 
     X = ca.MX.sym("x", n_x)
     P = ca.MX.sym("p", 0, 1)
