@@ -197,6 +197,8 @@ MUTATIONS = [
     Mutation("a stage's starts grouped across problems (a unit mixes problems: one NLP built for another's starts)",
              "designopt/solve/tasks.py", "groups.setdefault((id(t.problem), t.transcription, t.profile), [])",
              "groups.setdefault((t.transcription, t.profile), [])", ("tests/test_search.py",)),
+    Mutation("one problem's starts dispatched in pieces (a worker idles while another runs a piece's tail)",
+             "designopt/solve/tasks.py", "    if len(groups) == 1:\n", "    if False:\n", ("tests/test_search.py",)),
     Mutation("the modular neighbourhood search refines its worst screened assignments",
              "designopt/modular.py", "key=dict(evaluated).get)[:refine]",
              "key=lambda a: -dict(evaluated)[a])[:refine]", ("tests/test_modular.py",)),

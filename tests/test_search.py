@@ -186,10 +186,10 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
 
 @settings(max_examples=60, deadline=None)
 @given(starts=st.lists(st.integers(1, 12), min_size=1, max_size=12), workers=st.integers(1, 4))
-def test_a_problems_starts_go_to_one_worker_when_there_are_problems_enough(starts, workers):
-    """`units`: every task dispatched exactly once, in its order; a unit holds one problem's starts only; starts are
-    grouped when there are at least two problems per worker (else one task per unit), in pieces of at most a
-    quarter of a worker's share."""
+def test_a_problems_starts_go_to_few_workers(starts, workers):
+    """`units`: every task dispatched exactly once, in its order; a unit holds one problem's starts only; with
+    several problems, starts are grouped in pieces of at most a quarter of a worker's share, cut only where that
+    cap forces it (so a worker builds few problems' NLPs); one problem goes out a start per unit."""
     problems = [object() for _ in starts]
     profile, transcription = SolverProfile(), Collocation()
     tasks = [Task("c", "explore", p, transcription, profile, Seeded(0, i))
@@ -200,10 +200,9 @@ def test_a_problems_starts_go_to_one_worker_when_there_are_problems_enough(start
     for u in dispatched:
         assert len({id(t.problem) for t in u}) == 1
         assert [t.start.index for t in u] == sorted(t.start.index for t in u)
-    if len(problems) < 2 * workers:
+    if len(problems) == 1:
         assert all(len(u) == 1 for u in dispatched)
     else:
         most = max(1, len(tasks) // (4 * workers))
         assert all(len(u) <= most for u in dispatched)
-        # a problem is cut only where the cap forces it
         assert len(dispatched) == sum(-(-n // most) for n in starts)

@@ -62,15 +62,17 @@ def _run_all(unit: list[Task]) -> list[tuple[Task, Solution]]:
 
 
 def units(tasks: list[Task], workers: int) -> list[list[Task]]:
-    """How tasks go to workers: every start of one problem (the same problem object, transcription and profile) in
-    one unit when there are at least two such groups per worker -- a worker then builds and prepares each
-    problem's NLP once instead of every worker building it (a modular enumeration's assignments, a sweep's
-    structures) -- else one task per unit, so that the starts of a few problems spread over every worker.
-    A group is cut into pieces of at most len(tasks) / (4 workers) tasks, so that no unit is a long tail."""
+    """How tasks go to workers. The starts of one problem (the same problem object, transcription and profile) go
+    together, in pieces of at most len(tasks) / (4 workers) tasks: every worker gets about four units, no unit is a
+    long tail, and a worker builds and prepares the NLPs of a few problems instead of every worker every
+    problem's (a sweep's structures, a modular enumeration's assignments; on 64 workers a 126-structure sweep's
+    exploration went 75 -> 36 s against a task per unit, replayed by benchmarks/sweep_scaling.py). A stage of one
+    problem goes out a task per unit: every worker builds that problem whatever the units, and single starts
+    balance best."""
     groups: dict[tuple, list[Task]] = {}
     for t in tasks:
         groups.setdefault((id(t.problem), t.transcription, t.profile), []).append(t)
-    if len(groups) < 2 * workers:
+    if len(groups) == 1:
         return [[t] for t in tasks]
     most = max(1, len(tasks) // (4 * workers))
     return [group[i : i + most] for group in groups.values() for i in range(0, len(group), most)]
