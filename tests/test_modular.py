@@ -14,7 +14,13 @@ from hypothesis import strategies as st
 
 from designopt.config import parse_config
 from designopt.design_space import build_chain
-from designopt.experiments.modular import catalogue_from_config, fix_modules, module_values, with_modular_cost
+from designopt.experiments.modular import (
+    REFINE_STARTS,
+    catalogue_from_config,
+    fix_modules,
+    module_values,
+    with_modular_cost,
+)
 from designopt.kinematics.joints import Role
 from designopt.modular import (
     Catalogue,
@@ -131,6 +137,7 @@ def test_modular_command_writes_every_stage(tmp_path):
     assert 1 <= len(refined) <= 3
     nb = summary[summary["case"].isin(refined)]
     assert {"explore", "refine"} <= set(nb["stage"])  # coarse to fine (no screen on 12 waypoints), not the paper's
+    assert (nb[nb["stage"] == "explore"].groupby("case").size() == REFINE_STARTS).all()  # twice the default's starts
     rows = summary[summary["case"].isin(screened) & (summary["tracks"].astype(str) == "True")]
     costs = rows.groupby("case")["design_cost"].min()
     third = costs.sort_values().iloc[min(3, len(costs)) - 1]
