@@ -175,11 +175,13 @@ def test_a_path_beside_the_block_is_a_config_error(tmp_path):
 
 def test_the_cells_assembled_jacobian_equals_casadis(rng):
     """The clearance and floor rows' Jacobian assembled from their blocks (and the linear rows' own) equals the
-    Jacobian CasADi derives from the whole constraint graph, at random points."""
+    Jacobian CasADi derives from the whole constraint graph, at random points; so does the objective's gradient
+    assembled from the waypoint blocks (the clearance blocks add no objective term) and the quadratic terms."""
     nlp = Collocation().build(_placement_problem(cell=True)).nlp
-    ours = nlp.jacobian("none")
+    ours, ours_grad = nlp.jacobian("none"), nlp.gradient("none")
     ref = ca.Function("ref", [nlp.x], [nlp.g, ca.jacobian(nlp.g, nlp.x)])
+    ref_grad = ca.Function("ref_grad", [nlp.x], [nlp.f, ca.gradient(nlp.f, nlp.x)])
     for _ in range(3):
         x = rng.normal(size=nlp.n_variables)
-        for a, b in zip(ours(x, []), ref(x), strict=True):
+        for a, b in [*zip(ours(x, []), ref(x), strict=True), *zip(ours_grad(x, []), ref_grad(x), strict=True)]:
             np.testing.assert_allclose(np.array(ca.DM(a)), np.array(ca.DM(b)), rtol=1e-9, atol=1e-9)

@@ -1,4 +1,5 @@
-"""Constraint Jacobian assembled from per-point blocks, as the Hessian is (`designopt.transcriptions.hessian`).
+"""Constraint Jacobian and objective gradient assembled from per-point blocks, as the Hessian is
+(`designopt.transcriptions.hessian`).
 
 Every nonlinear constraint row of a transcribed problem is a row of some c_k(y_k) at one point (a waypoint, a
 collocation point) with y_k = (q_k, q_d); the other rows (collocation ties, midpoint bounds) are linear or small.
@@ -6,6 +7,8 @@ So dg/dx is the small Jacobians dc/dy of one (optionally compiled) block functio
 scattered into one sparse matrix, plus the Jacobian of the remaining rows, which CasADi derives from their own,
 small expressions. Deriving it from the whole SX graph instead colours the dense design-joint columns: most of
 the NLP's build time (0.17 s of the main job's, 4.1 s of the pocket cell's; benchmarks/speed_table.py).
+Likewise the objective f(x) = sum_k phi_k(y_k) + quadratic(x): its gradient is the blocks' dphi/dy scattered and
+added, plus the quadratic terms' own (small) gradient, instead of a reverse sweep of the whole graph.
 """
 
 from __future__ import annotations
@@ -67,3 +70,42 @@ def assemble_jacobian(x, g, g_of: ca.Function,
     values.append(rest_fn(X))
     nz = ca.vertcat(*values)[ca.DM(order.tolist())]
     return ca.Function("jac_g", [X, P], [g_of(X), ca.MX(sp, nz)], ["x", "p"], ["g", "jac_g_x"])
+
+
+def block_gradient_function(terms: ca.Function, compile_mode: str) -> ca.Function | None:
+    """(y, *inputs) -> dphi/dy as a dense column, for a block's (y, *inputs) -> (phi, c); None when phi does not
+    depend on y (a clearance block)."""
+    y = ca.SX.sym("y", terms.sparsity_in(0))
+    params = [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
+    phi, _ = terms(y, *params)
+    grad = ca.gradient(phi, y)
+    if not grad.nnz():
+        return None
+    return compiled(ca.Function("block_gradient", [y, *params], [ca.densify(grad)]), compile_mode)
+
+
+def assemble_gradient(x, quadratic, f_of: ca.Function,
+                      groups: list[tuple[ca.Function | None, np.ndarray, list]]) -> ca.Function:
+    """grad_f(x, p) -> (f, df/dx), for nlpsol's ``grad_f`` option, of f(x) = sum over the blocks' points of
+    phi_k(y_k) + ``quadratic``(x).
+
+    ``x``: the NLP's SX decision vector; ``quadratic``: the quadratic terms as an SX expression of it (or a
+    number); ``f_of``: x -> f. Each group is (block, y_index, block_inputs) with ``block`` from
+    `block_gradient_function` (None: no objective term), ``y_index`` (N x n_y) the position in x of each block
+    variable and ``block_inputs`` the block's constant extra inputs (mapped). Contributions to one entry add up.
+    """
+    n_x = x.shape[0]
+    X = ca.MX.sym("x", n_x)
+    P = ca.MX.sym("p", 0, 1)
+    values, rows = [], []
+    for block, y_index, block_inputs in groups:
+        if block is not None:
+            values.append(ca.vec(block.map(y_index.shape[0])(per_point(X, y_index), *block_inputs)))
+            rows.append(y_index.ravel())  # point by point, as map stacks the blocks' outputs
+    rows = np.concatenate([*rows, np.zeros(0, int)])
+    # one 1 per column: block entry e adds to entry rows[e] of the gradient
+    scatter = ca.DM(ccs_sparsity(n_x, len(rows), rows, np.arange(len(rows))), 1.0)
+    grad = ca.mtimes(scatter, ca.vertcat(*values)) if len(rows) else ca.MX(n_x, 1)
+    if not isinstance(quadratic, int | float):
+        grad += ca.Function("grad_quadratic", [x], [ca.densify(ca.gradient(quadratic, x))])(X)
+    return ca.Function("grad_f", [X, P], [f_of(X), grad], ["x", "p"], ["f", "grad_f_x"])
