@@ -354,8 +354,6 @@ def modular(
                                                                 "screen (0: no neighbourhood search).")] = 300,
     refine: Annotated[int, typer.Option("--refine", min=1, help="Best screened assignments the neighbourhood "
                                                                 "search searches on the full path.")] = 8,
-    rescreen: Annotated[int, typer.Option("--rescreen", min=0, help="Best screened assignments re-ranked on 40 "
-                                                                    "waypoints before the refinement (0: none).")] = 40,
 ):
     """Modular design: continuous TO with L_mod, round links to modules, re-solve placement, search neighbouring
     assignments (+ FK, plain TO)."""
@@ -364,7 +362,7 @@ def modular(
     cfg = load(config)
     with Bar("modular") as bar:
         result = run_modular(cfg, out_dir, name, bar, resume=resume, jobs=jobs, weight=weight,
-                             neighbourhood_budget=budget, neighbourhood_refine=refine, rescreen=rescreen)
+                             neighbourhood_budget=budget, neighbourhood_refine=refine)
     show(_frame_table(result.table, "modular design: best tracking start per stage"))
     out.print(f"results: {result.directory.path}")
 

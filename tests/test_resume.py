@@ -146,14 +146,11 @@ def test_modular_resumes(tmp_path):
     keys = set(after[KEY].itertuples(index=False, name=None))
     screened = {k for k in keys if k[0].startswith("sc-")}
     assert len(screened) == 3 * 12  # the budget's 12 assignments, 3 screening starts each
-    rescreened = {k for k in keys if k[0].startswith("rs-")}  # the screened re-ranked, one warm solve each
-    assert 1 <= len(rescreened) <= 12 and {k[1] for k in rescreened} == {"screen"}
-    assert {k[0][3:] for k in rescreened} <= {k[0][3:] for k in screened}
     searched = {k for k in keys if k[0].startswith("nb-")}
-    refined = {k for k in searched if k[1] == "refine"}  # the best re-ranked, searched on the full path
+    refined = {k for k in searched if k[1] == "refine"}  # the best screened, searched on the full path
     assert 1 <= len({k[0] for k in refined}) <= 2  # --refine 2
     assert {k[1] for k in searched} == {"explore", "refine"}  # the default search (no screen on 12 waypoints)
-    check_resumed(run, before, solves | rounded | screened | rescreened | searched, result)
+    check_resumed(run, before, solves | rounded | screened | searched, result)
     assert len(pd.read_csv(run / "table.csv")) == 6
 
 

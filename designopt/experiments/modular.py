@@ -8,9 +8,8 @@ Stages, each written to summary.csv as a ``case``:
   neighbourhood       beyond the paper: a search over module assignments, coarse to fine like the continuous one --
                       a local search (one link's module changed at a time) from the rounded assignment and from
                       seeded random ones, each candidate screened on a coarse sampling of the path (cases
-                      sc-<modules>); the `RESCREEN` best screened re-ranked on a finer sampling, each solved warm
-                      from its screening optimum (cases rs-<modules>); the best of those searched on the full path
-                      with the default search at `REFINE_STARTS` coarse starts (cases nb-<modules>)
+                      sc-<modules>); the best screened searched on the full path with the default search at
+                      `REFINE_STARTS` coarse starts (cases nb-<modules>)
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 
 Every stage of the paper's method is a search of one problem with the config's search (the shipped config uses
@@ -44,9 +43,8 @@ from designopt.modular import (
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
-from designopt.solve import Job, Search, Seeded, SolverProfile, Task, best_solution, preset, run_search
-from designopt.solve.search import by_job
-from designopt.solve.strategies.coarse_to_fine import coarse_problem, lifted_tasks
+from designopt.solve import Job, Search, Seeded, SolverProfile, Task, preset, run_search
+from designopt.solve.strategies.coarse_to_fine import coarse_problem
 from designopt.transcriptions import ForwardKinematics
 
 STAGES = ("continuous", "continuous_modular", "rounded", "modular", "neighbourhood", "fk")
@@ -56,8 +54,6 @@ NEIGHBOURHOOD_BUDGET = 300  # module assignments the neighbourhood search may sc
 NEIGHBOURHOOD_RESTARTS = 8  # seeded random assignments it starts from after the rounded one
 NEIGHBOURHOOD_REFINE = 8  # best screened assignments re-solved on the full path
 SCREEN_WAYPOINTS = 10  # the screening's sampling of the path
-RESCREEN = 40  # best screened assignments re-ranked on RESCREEN_WAYPOINTS before the refinement (0: none)
-RESCREEN_WAYPOINTS = 40  # the second screen's sampling of the path (all of it when it has fewer)
 REFINE_STARTS = 160  # coarse starts of each best screened assignment's full-path search (the default search has 80)
 # w_lin (1/m^2) and w_ang of the similarity distance (SPEC §3)
 LINEAR_WEIGHT, ANGULAR_WEIGHT = 1.0, 0.25
@@ -141,7 +137,7 @@ def _setup(cfg: Config, out_root: Path, experiment: str, run_name: str | None, r
 def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progress: Progress | None = None,
                 figures: bool = True, resume: bool = False, jobs: int = -1, weight: float = WEIGHT,
                 neighbourhood_budget: int = NEIGHBOURHOOD_BUDGET, search: Search | None = None,
-                neighbourhood_refine: int = NEIGHBOURHOOD_REFINE, rescreen: int = RESCREEN) -> ModularResult:
+                neighbourhood_refine: int = NEIGHBOURHOOD_REFINE) -> ModularResult:
     s = _setup(cfg, out_root, "modular", run_name, resume, jobs, progress, search)
     catalogue, run, base = s.catalogue, s.run, s.base
     best = {"continuous": _stage(s, base, "continuous")}
@@ -151,8 +147,7 @@ def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progre
     searched = assignment
     if modular is not None and neighbourhood_budget:
         searched, best["neighbourhood"], screened = _module_search(s, base, catalogue, placement, assignment, modular,
-                                                                    neighbourhood_budget, refine=neighbourhood_refine,
-                                                                    rescreen=rescreen)
+                                                                    neighbourhood_budget, refine=neighbourhood_refine)
         run.log(f"neighbourhood search: {screened} assignments screened, best {[k + 1 for k in searched]}")
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
@@ -221,35 +216,22 @@ def module_refine(search: Search) -> Search:
 
 
 def _module_search(setup, base, catalogue, placement, rounded, modular, budget, restarts=NEIGHBOURHOOD_RESTARTS,
-                   refine=NEIGHBOURHOOD_REFINE, rescreen=RESCREEN):
+                   refine=NEIGHBOURHOOD_REFINE):
     """The neighbourhood stage: a local search over assignments on screening costs, from the rounded assignment
-    and ``restarts`` seeded random ones, within ``budget`` screened assignments; the ``rescreen`` best screened
-    re-ranked on `RESCREEN_WAYPOINTS` (`rescreened`); then the ``refine`` best of those searched on the full path
-    (`module_refine`). Returns (best assignment, its solution, assignments screened); never worse than the
-    rounded assignment's re-solve ``modular``."""
+    and ``restarts`` seeded random ones, within ``budget`` screened assignments; then the ``refine`` best screened
+    searched on the full path (`module_refine`). Returns (best assignment, its solution, assignments
+    screened); never worse than the rounded assignment's re-solve ``modular``."""
     screen = ModuleCosts(setup, base, catalogue, placement, "sc-", module_screen(setup.search), SCREEN_WAYPOINTS)
-    ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget, restarts,
-                                            max(refine, rescreen), setup.search.seed)
-    if rescreen:
-        ranked = rescreened(ranked, ModuleCosts(setup, base, catalogue, placement, "rs-", module_screen(setup.search),
-                                                RESCREEN_WAYPOINTS, lifted_from=screen))
+    ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget, restarts, refine,
+                                            setup.search.seed)
     full = ModuleCosts(setup, base, catalogue, placement, "nb-", module_refine(setup.search))
     full.best[tuple(rounded)] = modular  # already solved: the modular stage
-    full(ranked[:refine])
+    full(ranked)
     solved = {a: sol for a, sol in full.best.items() if sol is not None and sol.metrics.tracks}
     if not solved:
         return list(rounded), modular, len(evaluated)
     best = min(solved, key=lambda a: solved[a].metrics.design_cost)
     return list(best), solved[best], len(evaluated)
-
-
-def rescreened(ranked: list, costs) -> list:
-    """``ranked`` (best screened first) re-ranked by ``costs(ranked)``, a finer screen: those it tracks by its cost,
-    then the rest in their first order. The 10-waypoint screen ranks assignments well overall but not at the top
-    (the enumeration's best full-path cost came from screening rank 38: docs/results.md)."""
-    finer = dict(zip(ranked, costs(ranked), strict=True))
-    tracked = sorted((a for a in ranked if np.isfinite(finer[a])), key=lambda a: finer[a])
-    return tracked + [a for a in ranked if not np.isfinite(finer[a])]
 
 
 def _digits(assignment) -> str:
@@ -260,14 +242,13 @@ class ModuleCosts:
     """``evaluate(assignments) -> costs`` for `neighbourhood_search`: every assignment's modules-fixed problem
     (placement and trajectory free, from the rounded stage's placement; on ``waypoints`` of the path, None: all)
     searched with ``search`` (None: the experiment's, like the ``modular`` stage), all of a batch in one search
-    (cases ``<tag><module numbers>``), or, ``lifted_from`` another sampling's costs, solved once warm from that one's
-    best solution (`designopt.solve.Lifted`, the search's profile warmed); NaN when no start tracks. ``best`` keeps
-    each evaluated assignment's best solution."""
+    (cases ``<tag><module numbers>``); NaN when no start tracks. ``best`` keeps each evaluated assignment's best
+    solution."""
 
     def __init__(self, setup, base, catalogue, placement, tag, search: Search | None = None,
-                 waypoints: int | None = None, lifted_from: ModuleCosts | None = None):
+                 waypoints: int | None = None):
         self.setup, self.base, self.catalogue, self.placement, self.tag = setup, base, catalogue, placement, tag
-        self.search, self.waypoints, self.lifted_from = search or setup.search, waypoints, lifted_from
+        self.search, self.waypoints = search or setup.search, waypoints
         self.best: dict[tuple[int, ...], Solution | None] = {}
 
     def problem(self, assignment) -> DesignProblem:
@@ -277,13 +258,8 @@ class ModuleCosts:
     def __call__(self, batch):
         todo = [a for a in batch if a not in self.best]  # known already: e.g. the rounded assignment's re-solve
         jobs = [Job(f"{self.tag}{_digits(a)}", self.problem(a)) for a in todo]
-        if self.lifted_from is None:
-            found = [searched.best[1] for searched in run_search(jobs, self.search, self.setup.execute)]
-        else:
-            warm = [[(None, self.lifted_from.best[a])] for a in todo]
-            done = self.setup.execute(lifted_tasks(jobs, warm, 1, "screen", None, self.search))
-            found = [best_solution([sol for _, sol in d]) for d in by_job(jobs, done)]
-        self.best.update(zip(todo, found, strict=True))
+        for a, searched in zip(todo, run_search(jobs, self.search, self.setup.execute), strict=True):
+            self.best[a] = searched.best[1]
         return [self.best[a].metrics.design_cost if self.best[a] is not None else np.nan for a in batch]
 
 
