@@ -132,6 +132,28 @@ def test_compile_cache_is_keyed_by_the_function_in_any_process(tmp_path, monkeyp
     assert sorted(tmp_path.glob("*.so")) == libraries
 
 
+def test_a_hessian_block_found_in_the_cache_is_not_derived_again(tmp_path, monkeypatch):
+    """The compiled Hessian block equals the interpreted one; it is cached under the terms it is derived from,
+    so that another terms function gets another library and a build that finds its library derives nothing
+    (no symbolic Hessian: most of a warm build)."""
+    from designopt.transcriptions.hessian import block_hessian_function
+
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    y, s_W = ca.SX.sym("y", 3), ca.SX.sym("s_W", 2)
+    rng = np.random.default_rng(3)
+    args = [rng.normal(size=3), 0.7, rng.normal(size=2), rng.normal(size=2)]
+    for k, scale in enumerate((1.0, 2.0)):
+        terms = ca.Function("terms", [y, s_W], [scale * ca.sin(y[0]) * ca.sumsqr(y),
+                                                ca.vertcat(y[1] * y[2] - s_W[0], ca.cos(y[0]) * s_W[1])])
+        ours, ref = block_hessian_function(terms, 3, 2, "O0"), block_hessian_function(terms, 3, 2, "none")
+        np.testing.assert_allclose(np.array(ours(*args)), np.array(ref(*args)), rtol=1e-13)
+        assert len(list(tmp_path.glob("waypoint_hessian_*.so"))) == k + 1
+    monkeypatch.setattr(ca, "hessian", lambda *a: pytest.fail("derived although cached"))
+    again = block_hessian_function(terms, 3, 2, "O0")
+    np.testing.assert_allclose(np.array(again(*args)), np.array(ref(*args)), rtol=1e-13)
+    assert len(list(tmp_path.glob("waypoint_hessian_*.so"))) == 2
+
+
 def test_ik_start_tracks_a_reachable_path():
     cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 20},
            "placement": {"xyz": [0.45, 0.0, -0.2]}}

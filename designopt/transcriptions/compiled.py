@@ -11,6 +11,7 @@ import hashlib
 import os
 import subprocess
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 import casadi as ca
@@ -31,20 +32,29 @@ def compiled(fn: ca.Function, mode: str = "O0") -> ca.Function:
     Falls back to the interpreted function if no C compiler works, so a machine without gcc is slower,
     not broken.
     """
+    return compiled_as(fn.name(), fn.serialize(), lambda: fn, mode)
+
+
+def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mode: str = "O0") -> ca.Function:
+    """The function ``derive()`` (named ``name``) as compiled C, found in the cache by ``identity`` -- any text
+    that determines the function, e.g. its serialised graph, or the small graph it is derived from and how --
+    so that a function found there is never derived (its symbolic derivation and serialisation are most of a
+    warm build). Mode ``none``: ``derive()`` itself."""
     if mode == "none":
-        return fn
+        return derive()
     if mode not in COMPILE_MODES:
         raise ValueError(f"compile must be one of {COMPILE_MODES}, got {mode!r}")
-    # Keyed by the function's serialised graph (deterministic across processes; 4-6x cheaper than generating its
-    # C, which is only needed when the library is missing: 0.58 s of the pocket cell's warm build).
-    key = hashlib.sha256(f"{fn.serialize()}|{mode}|{ca.__version__}|{GENERATOR}".encode()).hexdigest()[:20]
-    library = cache_dir() / f"{fn.name()}_{key}.so"
+    # Serialised graphs are deterministic across processes; hashing one is 4-6x cheaper than generating its C,
+    # which is only needed when the library is missing (0.58 s of the pocket cell's warm build).
+    key = hashlib.sha256(f"{identity}|{mode}|{ca.__version__}|{GENERATOR}".encode()).hexdigest()[:20]
+    library = cache_dir() / f"{name}_{key}.so"
     if not library.exists():
+        fn = derive()
         try:
             _build(_source(fn), library, mode)
         except (OSError, subprocess.CalledProcessError):
             return fn
-    return ca.external(fn.name(), str(library))
+    return ca.external(name, str(library))
 
 
 def _source(fn: ca.Function) -> str:

@@ -10,10 +10,12 @@ Hessian of the whole graph, which must colour the dense design-joint columns.
 
 from __future__ import annotations
 
+import inspect
+
 import casadi as ca
 import numpy as np
 
-from designopt.transcriptions.compiled import compiled
+from designopt.transcriptions.compiled import compiled_as
 
 
 def per_point(v: ca.MX, index: np.ndarray) -> ca.MX:
@@ -34,17 +36,28 @@ def ccs_sparsity(n_rows: int, n_cols: int, rows: np.ndarray, cols: np.ndarray) -
 
 
 def block_hessian_function(terms: ca.Function, n_y: int, n_c: int, compile_mode: str) -> ca.Function:
-    """Upper-triangular entries (row-major over a <= b) of d2/dy2 [sigma phi(y) + mu . c(y)]."""
-    y = ca.SX.sym("y", n_y)
-    sigma = ca.SX.sym("sigma")
-    mu = ca.SX.sym("mu", n_c)
-    params = [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
-    phi, c = terms(y, *params)
-    lagrangian = sigma * phi + (ca.dot(mu, c) if n_c else 0)
-    H = ca.hessian(lagrangian, y)[0]
-    upper = ca.vertcat(*[H[a, b] for a in range(n_y) for b in range(a, n_y)])
-    fn = ca.Function("waypoint_hessian", [y, sigma, mu, *params], [upper])
-    return compiled(fn, compile_mode)
+    """Upper-triangular entries (row-major over a <= b) of d2/dy2 [sigma phi(y) + mu . c(y)]. Compiled, it is
+    found in the cache by ``terms`` and this derivation, so that a warm build derives nothing."""
+
+    def derive() -> ca.Function:
+        y = ca.SX.sym("y", n_y)
+        sigma = ca.SX.sym("sigma")
+        mu = ca.SX.sym("mu", n_c)
+        params = [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
+        phi, c = terms(y, *params)
+        lagrangian = sigma * phi + (ca.dot(mu, c) if n_c else 0)
+        H = ca.hessian(lagrangian, y)[0]
+        upper = ca.vertcat(*[H[a, b] for a in range(n_y) for b in range(a, n_y)])
+        return ca.Function("waypoint_hessian", [y, sigma, mu, *params], [upper])
+
+    return compiled_as("waypoint_hessian", derivation_identity(terms, block_hessian_function, n_y, n_c), derive,
+                       compile_mode)
+
+
+def derivation_identity(terms: ca.Function, derivation, *args) -> str:
+    """What determines a block function derived from ``terms`` by ``derivation`` (its source code) with ``args``:
+    the compile cache's key for it (`compiled_as`)."""
+    return f"{terms.serialize()}|{inspect.getsource(derivation)}|{args}"
 
 
 def assemble_hessian(
