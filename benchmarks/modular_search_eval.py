@@ -47,7 +47,7 @@ def replay(screen: dict, full: dict, start, seed: int, budget: int, restarts: in
     without a full-path cost). The answer is the best full-path cost among the refined candidates that the
     enumeration solved on the full path: an upper bound when some were not (they ranked below its refinement), NaN
     when none was. An assignment the screening did not track costs inf."""
-    ranked, evaluated = screened_candidates(start, n_modules, lambda b: [screen.get(a, np.inf) for a in b], budget,
+    ranked, evaluated = screened_candidates(start, n_modules, lambda b, _: [screen.get(a, np.inf) for a in b], budget,
                                             restarts, refine, seed)
     known = [full[a] for a in ranked if a in full]
     found = min(c for _, c in evaluated)

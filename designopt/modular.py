@@ -99,17 +99,19 @@ def neighbours(assignment: tuple[int, ...], n_modules: int) -> list[tuple[int, .
 def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate, budget: int):
     """Best-improvement local search over module assignments, from each of ``starts`` in turn.
 
-    ``evaluate(assignments) -> costs`` solves a batch (NaN or inf: does not track); an assignment is evaluated
-    at most once. A step evaluates every neighbour of the incumbent (one link's module changed) and moves to
-    the cheapest if it beats the incumbent; a start ends at a local optimum of this neighbourhood or when
-    ``budget`` evaluations are spent. Returns (best assignment, its cost, every evaluation in order).
+    ``evaluate(assignments, incumbent) -> costs`` solves a batch (NaN or inf: does not track), the neighbours of
+    ``incumbent`` (None for a start); an assignment is evaluated at most once. A step evaluates every neighbour of
+    the incumbent (one link's module changed) and moves to the cheapest if it beats the incumbent; a start ends
+    at a local optimum of this neighbourhood or when ``budget`` evaluations are spent. Returns (best assignment,
+    its cost, every evaluation in order).
     """
     seen: dict[tuple[int, ...], float] = {}
 
-    def costs(batch):
+    def costs(batch, incumbent=None):
         new = [a for a in dict.fromkeys(batch) if a not in seen][: max(budget - len(seen), 0)]
         if new:
-            seen.update({a: (float(c) if np.isfinite(c) else np.inf) for a, c in zip(new, evaluate(new), strict=True)})
+            values = evaluate(new, incumbent)
+            seen.update({a: (float(c) if np.isfinite(c) else np.inf) for a, c in zip(new, values, strict=True)})
         return [seen.get(a, np.inf) for a in batch]
 
     for start in starts:
@@ -117,7 +119,7 @@ def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate
         (cost,) = costs([current])
         while len(seen) < budget:
             around = neighbours(current, n_modules)
-            values = costs(around)
+            values = costs(around, current)
             k = int(np.argmin(values))
             if values[k] >= cost:
                 break
@@ -134,8 +136,9 @@ def random_assignments(count: int, n_links: int, n_modules: int, seed: int) -> l
 
 def screened_candidates(start: tuple[int, ...], n_modules: int, screen, budget: int, restarts: int, refine: int,
                         seed: int):
-    """The coarse half of the modular search: `neighbourhood_search` on screening costs ``screen(assignments)``
-    from ``start`` (the rounded assignment) and ``restarts`` seeded random assignments, within ``budget``. Returns
+    """The coarse half of the modular search: `neighbourhood_search` on screening costs ``screen(assignments,
+    incumbent)`` from ``start`` (the rounded assignment) and ``restarts`` seeded random assignments, within
+    ``budget``. Returns
     (the ``refine`` best screened assignments that track, best first; every (assignment, screening cost) in the
     order screened)."""
     starts = [tuple(start), *random_assignments(restarts, len(start), n_modules, seed)]

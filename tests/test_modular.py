@@ -130,6 +130,8 @@ def test_modular_command_writes_every_stage(tmp_path):
     assert {"continuous", "continuous_modular", "rounded", "modular", "fk"} <= stages
     screened = {c for c in stages if c.startswith("sc-")}  # the neighbourhood search's screened candidates
     assert len(screened) == 30  # the budget, all spent: eight random restarts are more than 30 can finish
+    warm = summary[summary["stage"] == "warm"]  # neighbours of an incumbent: one more start, from its optimum
+    assert len(warm) and warm["case"].str.startswith("sc-").all() and warm["case"].is_unique
     size = summary.groupby([summary["case"].str[:3], "stage"])["n_variables"].agg(set)
     assert len(size["sc-", "start"]) == 1  # screened on 10 of the 12 waypoints, searched (default) on all 12
     assert max(size["sc-", "start"]) < min(size["nb-", "refine"])
@@ -234,8 +236,10 @@ def test_neighbourhood_search_finds_the_optimum_of_a_separable_cost():
 
     calls = []
 
-    def evaluate(batch):
+    def evaluate(batch, incumbent):
         calls.extend(batch)
+        # a step's batch is its incumbent's neighbours (one link changed), which warm-start from it
+        assert incumbent is None or all(sum(x != y for x, y in zip(a, incumbent, strict=True)) == 1 for a in batch)
         return [cost(a) for a in batch]
 
     truth = min(itertools.product(range(3), repeat=4), key=cost)
@@ -250,11 +254,11 @@ def test_neighbourhood_search_keeps_its_budget_and_escapes_a_rounding_trap():
     """A deceptive cost: the rounded start (0, 0) is a local optimum, (1, 1) the global one; with a second
     start the search finds it; the budget caps the evaluations."""
     costs = {(0, 0): 1.0, (0, 1): 2.0, (1, 0): 2.0, (1, 1): 0.5}
-    best, value, seen = neighbourhood_search([(0, 0)], 2, lambda b: [costs[a] for a in b], budget=10)
+    best, value, seen = neighbourhood_search([(0, 0)], 2, lambda b, _: [costs[a] for a in b], budget=10)
     assert tuple(best) == (0, 0) and len(seen) == 3  # stuck: both neighbours are worse
-    best, value, seen = neighbourhood_search([(0, 0), (1, 0)], 2, lambda b: [costs[a] for a in b], budget=10)
+    best, value, seen = neighbourhood_search([(0, 0), (1, 0)], 2, lambda b, _: [costs[a] for a in b], budget=10)
     assert tuple(best) == (1, 1) and value == 0.5
-    _, _, seen = neighbourhood_search([(0, 0, 0)], 5, lambda b: [float(sum(a)) + 1 for a in b], budget=5)
+    _, _, seen = neighbourhood_search([(0, 0, 0)], 5, lambda b, _: [float(sum(a)) + 1 for a in b], budget=5)
     assert len(seen) == 5
-    nan = neighbourhood_search([(0,)], 3, lambda b: [np.nan if a == (0,) else 1.0 for a in b], budget=5)
+    nan = neighbourhood_search([(0,)], 3, lambda b, _: [np.nan if a == (0,) else 1.0 for a in b], budget=5)
     assert nan[0] in ([1], [2]) and nan[1] == 1.0  # a start that does not track is left for one that does

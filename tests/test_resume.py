@@ -145,7 +145,9 @@ def test_modular_resumes(tmp_path):
     assert len(rounded) == 1
     keys = set(after[KEY].itertuples(index=False, name=None))
     screened = {k for k in keys if k[0].startswith("sc-")}
-    assert len(screened) == 3 * 12  # the budget's 12 assignments, 3 screening starts each
+    assert len({k for k in screened if k[1] == "start"}) == 3 * 12  # the budget's 12 assignments, 3 starts each
+    warm = {k for k in screened if k[1] != "start"}  # a neighbour's one start from its incumbent
+    assert {k[1] for k in warm} == {"warm"} and len({k[0] for k in warm}) == len(warm) <= 11
     searched = {k for k in keys if k[0].startswith("nb-")}
     refined = {k for k in searched if k[1] == "refine"}  # the best screened, searched on the full path
     assert 1 <= len({k[0] for k in refined}) <= 2  # --refine 2

@@ -8,7 +8,8 @@ Stages, each written to summary.csv as a ``case``:
   neighbourhood       beyond the paper: a search over module assignments, coarse to fine like the continuous one --
                       a local search (one link's module changed at a time) from the rounded assignment and from
                       seeded random ones, each candidate screened on a coarse sampling of the path (cases
-                      sc-<modules>); the best screened searched on the full path with the default search at
+                      sc-<modules>; a neighbour of the incumbent also warm from the incumbent's screening
+                      optimum); the best screened searched on the full path with the default search at
                       `REFINE_STARTS` coarse starts (cases nb-<modules>)
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 
@@ -43,8 +44,9 @@ from designopt.modular import (
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
-from designopt.solve import Job, Search, Seeded, SolverProfile, Task, preset, run_search
-from designopt.solve.strategies.coarse_to_fine import coarse_problem
+from designopt.solve import Job, Search, Seeded, SolverProfile, Task, best_solution, preset, run_search
+from designopt.solve.search import by_job
+from designopt.solve.strategies.coarse_to_fine import coarse_problem, lifted_tasks
 from designopt.transcriptions import ForwardKinematics
 
 STAGES = ("continuous", "continuous_modular", "rounded", "modular", "neighbourhood", "fk")
@@ -239,11 +241,13 @@ def _digits(assignment) -> str:
 
 
 class ModuleCosts:
-    """``evaluate(assignments) -> costs`` for `neighbourhood_search`: every assignment's modules-fixed problem
-    (placement and trajectory free, from the rounded stage's placement; on ``waypoints`` of the path, None: all)
-    searched with ``search`` (None: the experiment's, like the ``modular`` stage), all of a batch in one search
-    (cases ``<tag><module numbers>``); NaN when no start tracks. ``best`` keeps each evaluated assignment's best
-    solution."""
+    """``evaluate(assignments, incumbent=None) -> costs`` for `neighbourhood_search`: every assignment's
+    modules-fixed problem (placement and trajectory free, from the rounded stage's placement; on ``waypoints`` of
+    the path, None: all) searched with ``search`` (None: the experiment's, like the ``modular`` stage), all of a
+    batch in one search (cases ``<tag><module numbers>``); the neighbours of an ``incumbent`` also get one warm
+    start from the incumbent's best solution (stage ``warm``): a module changed on one link moves the best
+    placement and trajectory little, so a basin one family member found is tried on its neighbours. NaN when no
+    start tracks. ``best`` keeps each evaluated assignment's best solution."""
 
     def __init__(self, setup, base, catalogue, placement, tag, search: Search | None = None,
                  waypoints: int | None = None):
@@ -255,11 +259,17 @@ class ModuleCosts:
         fixed = fix_modules(self.base, list(assignment), self.catalogue, self.placement)
         return fixed if self.waypoints is None else coarse_problem(fixed, self.waypoints)
 
-    def __call__(self, batch):
+    def __call__(self, batch, incumbent=None):
         todo = [a for a in batch if a not in self.best]  # known already: e.g. the rounded assignment's re-solve
         jobs = [Job(f"{self.tag}{_digits(a)}", self.problem(a)) for a in todo]
-        for a, searched in zip(todo, run_search(jobs, self.search, self.setup.execute), strict=True):
-            self.best[a] = searched.best[1]
+        found = [searched.best[1] for searched in run_search(jobs, self.search, self.setup.execute)]
+        warm = self.best.get(incumbent) if incumbent is not None else None
+        if warm is not None and jobs:
+            tasks = lifted_tasks(jobs, [[(None, warm)]] * len(jobs), 1, "warm", None, self.search)
+            done = by_job(jobs, self.setup.execute(tasks))
+            found = [best_solution([*([f] if f is not None else []), *(sol for _, sol in d)])
+                     for f, d in zip(found, done, strict=True)]
+        self.best.update(zip(todo, found, strict=True))
         return [self.best[a].metrics.design_cost if self.best[a] is not None else np.nan for a in batch]
 
 
@@ -317,7 +327,7 @@ def run_modular_study(cfg: Config, out_root: Path, run_name: str | None = None, 
     enum["neighbourhood_picked"] = False
     if rounded_assignment and neighbourhood_budget:
         picked, _, evaluated = neighbourhood_search([tuple(rounded_assignment)], len(subset),
-                                                    lambda batch: [by_assignment[a] for a in batch],
+                                                    lambda batch, _: [by_assignment[a] for a in batch],
                                                     neighbourhood_budget)
         label = " ".join(f"m{subset[k] + 1}" for k in picked)
         enum["neighbourhood_picked"] = enum["assignment"] == label
