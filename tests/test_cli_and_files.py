@@ -129,7 +129,7 @@ def test_missing_config_exits_2(tmp_path):
 
 def test_the_solution_set_is_an_output(finished_run):
     _, run = finished_run
-    optima = pd.read_csv(run / "solution_set.csv")
+    optima = pd.read_csv(run / "solution_set.csv", dtype={"seeds": str})  # "3 17", or "3": not a number
     summary = pd.read_csv(run / "summary.csv")
     explored = summary[summary["stage"] == "explore"]
     assert optima["reached_by"].sum() == explored["tracks"].sum()  # the exploration's optima, each solve once
