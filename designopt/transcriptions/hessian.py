@@ -35,15 +35,20 @@ def ccs_sparsity(n_rows: int, n_cols: int, rows: np.ndarray, cols: np.ndarray) -
     return ca.Sparsity(n_rows, n_cols, colind.tolist(), np.asarray(rows).tolist())
 
 
+def block_symbols(terms: ca.Function) -> tuple[ca.SX, list[ca.SX]]:
+    """Symbols for a block's (y, *inputs) -> (phi, c): y and the constant inputs, to derive its blocks from."""
+    y = ca.SX.sym("y", terms.sparsity_in(0))
+    return y, [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
+
+
 def block_hessian_function(terms: ca.Function, n_y: int, n_c: int, compile_mode: str) -> ca.Function:
     """Upper-triangular entries (row-major over a <= b) of d2/dy2 [sigma phi(y) + mu . c(y)]. Compiled, it is
     found in the cache by ``terms`` and this derivation, so that a warm build derives nothing."""
 
     def derive() -> ca.Function:
-        y = ca.SX.sym("y", n_y)
+        y, params = block_symbols(terms)
         sigma = ca.SX.sym("sigma")
         mu = ca.SX.sym("mu", n_c)
-        params = [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
         phi, c = terms(y, *params)
         lagrangian = sigma * phi + (ca.dot(mu, c) if n_c else 0)
         H = ca.hessian(lagrangian, y)[0]

@@ -17,14 +17,13 @@ import casadi as ca
 import numpy as np
 
 from designopt.transcriptions.compiled import compiled
-from designopt.transcriptions.hessian import ccs_sparsity, per_point
+from designopt.transcriptions.hessian import block_symbols, ccs_sparsity, per_point
 
 
 def block_jacobian_function(terms: ca.Function, compile_mode: str) -> tuple[ca.Function, np.ndarray, np.ndarray]:
     """(function (y, *inputs) -> the structural nonzeros of dc/dy as one column, their rows in c, their columns
     in y). ``terms`` is a block's (y, *inputs) -> (phi, c)."""
-    y = ca.SX.sym("y", terms.sparsity_in(0))
-    params = [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
+    y, params = block_symbols(terms)
     _, c = terms(y, *params)
     J = ca.jacobian(c, y)
     rows, cols = J.sparsity().get_triplet()
@@ -75,8 +74,7 @@ def assemble_jacobian(x, g, g_of: ca.Function,
 def block_gradient_function(terms: ca.Function, compile_mode: str) -> ca.Function | None:
     """(y, *inputs) -> dphi/dy as a dense column, for a block's (y, *inputs) -> (phi, c); None when phi does not
     depend on y (a clearance block)."""
-    y = ca.SX.sym("y", terms.sparsity_in(0))
-    params = [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
+    y, params = block_symbols(terms)
     phi, _ = terms(y, *params)
     grad = ca.gradient(phi, y)
     if not grad.nnz():
