@@ -138,9 +138,8 @@ def screened_candidates(start: tuple[int, ...], n_modules: int, screen, budget: 
                         seed: int):
     """The coarse half of the modular search: `neighbourhood_search` on screening costs ``screen(assignments,
     incumbent)`` from ``start`` (the rounded assignment) and ``restarts`` seeded random assignments, within
-    ``budget``. Returns
-    (the ``refine`` best screened assignments that track, best first; every (assignment, screening cost) in the
-    order screened)."""
+    ``budget``. Returns (the ``refine`` best screened assignments that track, best first; every (assignment,
+    screening cost) in the order screened)."""
     starts = [tuple(start), *random_assignments(restarts, len(start), n_modules, seed)]
     _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget)
     ranked = sorted((a for a, c in evaluated if np.isfinite(c)), key=dict(evaluated).get)[:refine]

@@ -263,7 +263,7 @@ class ModuleCosts:
         todo = [a for a in batch if a not in self.best]  # known already: e.g. the rounded assignment's re-solve
         jobs = [Job(f"{self.tag}{_digits(a)}", self.problem(a)) for a in todo]
         found = [searched.best[1] for searched in run_search(jobs, self.search, self.setup.execute)]
-        warm = self.best.get(incumbent) if incumbent is not None else None
+        warm = self.best.get(incumbent)  # None for a start, or an incumbent that did not track
         if warm is not None and jobs:
             tasks = lifted_tasks(jobs, [[(None, warm)]] * len(jobs), 1, "warm", None, self.search)
             done = by_job(jobs, self.setup.execute(tasks))
