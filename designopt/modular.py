@@ -26,6 +26,9 @@ PAPER_MODULES = (  # Table II of the paper: (theta free, d, a, alpha)
     {"d": 1.0, "a": 0.5, "alpha": 0.0},
     {"d": 0.5, "a": 0.5, "alpha": -math.pi / 2},
 )
+# Two screening costs this close (relative) are one optimum: IPOPT ends the same robot's optimum within ~1e-7 from
+# different starts, where distinct optima of the paper's catalogue lie >= 1e-4 apart.
+SAME_OPTIMUM = 1.0e-6
 
 
 @dataclass(frozen=True)
@@ -138,9 +141,24 @@ def screened_candidates(start: tuple[int, ...], n_modules: int, screen, budget: 
                         seed: int):
     """The coarse half of the modular search: `neighbourhood_search` on screening costs ``screen(assignments,
     incumbent)`` from ``start`` (the rounded assignment) and ``restarts`` seeded random assignments, within
-    ``budget``. Returns (the ``refine`` best screened assignments that track, best first; every (assignment,
-    screening cost) in the order screened)."""
+    ``budget``. Returns (the ``refine`` best screened assignments that track and are `distinct_optima`, best
+    first; every (assignment, screening cost) in the order screened)."""
     starts = [tuple(start), *random_assignments(restarts, len(start), n_modules, seed)]
     _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget)
-    ranked = sorted((a for a, c in evaluated if np.isfinite(c)), key=dict(evaluated).get)[:refine]
-    return ranked, evaluated
+    return distinct_optima([(a, c) for a, c in evaluated if np.isfinite(c)], refine), evaluated
+
+
+def distinct_optima(screened: list[tuple[tuple[int, ...], float]], count: int,
+                    rel_tol: float = SAME_OPTIMUM) -> list[tuple[int, ...]]:
+    """The ``count`` cheapest of ``(assignment, cost)`` pairs, best first, one per optimum: an assignment whose cost
+    equals (to ``rel_tol``) one already picked is skipped. Assignments that differ only where the free placement
+    and joint angles absorb the difference (a module's offset d along the first joint's axis, say) are the same
+    robot; screened from the same warm start they end at the same optimum to the last digits, and refining both
+    would solve one robot twice."""
+    picked: list[tuple[tuple[int, ...], float]] = []
+    for a, c in sorted(screened, key=lambda pair: pair[1]):
+        if len(picked) == count:
+            break
+        if not any(abs(c - kept) <= rel_tol * abs(kept) for _, kept in picked):
+            picked.append((a, c))
+    return [a for a, _ in picked]

@@ -28,7 +28,9 @@ from designopt.modular import (
     distance,
     modular_cost,
     nearest_modules,
+    distinct_optima,
     neighbourhood_search,
+    screened_candidates,
 )
 from designopt.problem import problem_from_config
 
@@ -262,3 +264,24 @@ def test_neighbourhood_search_keeps_its_budget_and_escapes_a_rounding_trap():
     assert len(seen) == 5
     nan = neighbourhood_search([(0,)], 3, lambda b, _: [np.nan if a == (0,) else 1.0 for a in b], budget=5)
     assert nan[0] in ([1], [2]) and nan[1] == 1.0  # a start that does not track is left for one that does
+
+
+def test_refined_candidates_are_distinct_optima():
+    """Link 1's module does not change the cost (as a module's offset along the first joint's axis, which the free
+    placement absorbs), so every cost comes in 3 equal copies, two of them 1e-9 apart as IPOPT ends one optimum
+    from two starts. The candidates sent to the full path are the cheapest *distinct* costs of all screened
+    (brute force over what the search screened), one assignment each; without the rule they would be copies."""
+    rng = np.random.default_rng(3)
+    table = rng.uniform(0, 1, (3, 3))
+
+    def cost(a):
+        return float(1.0 + sum(table[i, k] for i, k in enumerate(a[1:]))) * (1 + 1e-9 * (a[0] == 2))
+
+    ranked, evaluated = screened_candidates((0, 0, 0, 0), 3, lambda b, _: [cost(a) for a in b], budget=81,
+                                            restarts=2, refine=4, seed=0)
+    values = sorted({round(c, 6) for _, c in evaluated})[:4]
+    assert [round(cost(a), 6) for a in ranked] == values
+    assert len({a[1:] for a in ranked}) == 4  # four different robots, not one robot under four link-1 modules
+    copies = [(a, c) for a, c in evaluated if a[1:] == ranked[0][1:]]
+    assert len(copies) > 1 and distinct_optima(copies, 4) == [min(copies, key=lambda p: p[1])[0]]
+    assert distinct_optima([((0,), 1.0), ((1,), 1.0 + 2e-6)], 2) == [(0,), (1,)]  # 2e-6 apart: two optima
