@@ -26,9 +26,9 @@ from designopt.modular import (
     Catalogue,
     check_catalogue,
     distance,
+    distinct_optima,
     modular_cost,
     nearest_modules,
-    distinct_optima,
     neighbourhood_search,
     screened_candidates,
 )
