@@ -8,10 +8,10 @@ enumeration's costs in place of the solves. Prints, per budget, the distribution
 full-path answer / the best full-path cost of the enumeration) and how many assignments it screened.
 
 The replay uses the enumeration's screening (search seed 0) for every seed: what it measures is the local
-search and its restarts, not the screening's own seed-to-seed noise (real runs: docs/results.md).
+search and its starts, not the screening's own seed-to-seed noise (real runs: docs/results.md).
 
     .venv/bin/python benchmarks/modular_search_eval.py RUN_DIR [--first-seed 1000] [--seeds 20]
-        [--budget 100 200 300] [--restarts 8] [--refine 8] [--start 213151]
+        [--budget 100 200 300] [--sample-share 0.1667] [--refine 8] [--start 213151]
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from designopt.config import load_config
-from designopt.experiments.modular import catalogue_from_config
+from designopt.experiments.modular import NEIGHBOURHOOD_SAMPLE, catalogue_from_config
 from designopt.modular import screened_candidates
 from designopt.tables import COARSE_STAGES
 
@@ -42,13 +42,13 @@ def costs(run: Path) -> tuple[dict, dict]:
     return out[0], out[1]
 
 
-def replay(screen: dict, full: dict, start, seed: int, budget: int, restarts: int, refine: int, n_modules: int):
+def replay(screen: dict, full: dict, start, seed: int, budget: int, share: float, refine: int, n_modules: int):
     """(the best screening cost it found, the answer's full-path cost, assignments screened, refined candidates
     without a full-path cost). The answer is the best full-path cost among the refined candidates that the
     enumeration solved on the full path: an upper bound when some were not (they ranked below its refinement), NaN
     when none was. An assignment the screening did not track costs inf."""
     ranked, evaluated = screened_candidates(start, n_modules, lambda b, _: [screen.get(a, np.inf) for a in b], budget,
-                                            restarts, refine, seed)
+                                            round(budget * share), refine, seed)
     known = [full[a] for a in ranked if a in full]
     found = min(c for _, c in evaluated)
     return found, (min(known) if known else np.nan), len(evaluated), len(ranked) - len(known)
@@ -67,7 +67,8 @@ def main() -> None:
     parser.add_argument("--first-seed", type=int, default=1000)
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--budget", type=int, nargs="+", default=[100, 200, 300])
-    parser.add_argument("--restarts", type=int, default=8)
+    parser.add_argument("--sample-share", type=float, default=NEIGHBOURHOOD_SAMPLE,
+                        help="the share of the budget screened as a spread sample before the local searches")
     parser.add_argument("--refine", type=int, default=8)
     parser.add_argument("--start", default="213151",
                         help="the first start's modules (the rounded assignment; default: seed 0's in docs/results.md)")
@@ -81,7 +82,7 @@ def main() -> None:
     print(f"{len(screen)} assignments track on the screening (best {best_screen:.6g}), {len(full)} solved on the full "
           f"path (best {best:.6g}); seeds {args.first_seed}-{args.first_seed + args.seeds - 1}")
     for budget in args.budget:
-        found, answer, spent, unknown = zip(*[replay(screen, full, start, seed, budget, args.restarts, args.refine,
+        found, answer, spent, unknown = zip(*[replay(screen, full, start, seed, budget, args.sample_share, args.refine,
                                                      n_modules)
                                               for seed in range(args.first_seed, args.first_seed + args.seeds)],
                                             strict=True)

@@ -99,14 +99,17 @@ def neighbours(assignment: tuple[int, ...], n_modules: int) -> list[tuple[int, .
             if k != assignment[i]]
 
 
-def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate, budget: int):
+def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate, budget: int,
+                         cheapest_first: bool = False):
     """Best-improvement local search over module assignments, from each of ``starts`` in turn.
 
     ``evaluate(assignments, incumbent) -> costs`` solves a batch (NaN or inf: does not track), the neighbours of
     ``incumbent`` (None for a start); an assignment is evaluated at most once. A step evaluates every neighbour of
     the incumbent (one link's module changed) and moves to the cheapest if it beats the incumbent; a start ends
-    at a local optimum of this neighbourhood or when ``budget`` evaluations are spent. Returns (best assignment,
-    its cost, every evaluation in order).
+    at a local optimum of this neighbourhood or when ``budget`` evaluations are spent. ``cheapest_first``: every
+    start is evaluated first, in one batch, and the local searches run from the cheapest start on (a start
+    inside a basin searched already costs nothing more). Returns (best assignment, its cost, every evaluation in
+    order).
     """
     seen: dict[tuple[int, ...], float] = {}
 
@@ -117,8 +120,12 @@ def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate
             seen.update({a: (float(c) if np.isfinite(c) else np.inf) for a, c in zip(new, values, strict=True)})
         return [seen.get(a, np.inf) for a in batch]
 
+    starts = [tuple(a) for a in starts]
+    if cheapest_first:
+        values = costs(starts)
+        starts = [starts[i] for i in sorted(range(len(starts)), key=lambda i: (values[i], i))]
     for start in starts:
-        current = tuple(start)
+        current = start
         (cost,) = costs([current])
         while len(seen) < budget:
             around = neighbours(current, n_modules)
@@ -131,20 +138,23 @@ def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate
     return list(best), seen[best], list(seen.items())
 
 
-def random_assignments(count: int, n_links: int, n_modules: int, seed: int) -> list[tuple[int, ...]]:
-    """``count`` module assignments drawn uniformly, from ``seed`` alone."""
+def spread_assignments(count: int, n_links: int, n_modules: int, seed: int) -> list[tuple[int, ...]]:
+    """``count`` module assignments spread over the catalogue, from ``seed`` alone: on every link each module
+    appears equally often (to one; a Latin hypercube over the links), in a seeded random order per link."""
     rng = np.random.default_rng([seed, 25])
-    return [tuple(int(k) for k in rng.integers(0, n_modules, n_links)) for _ in range(count)]
+    columns = [rng.permutation(np.resize(np.arange(n_modules), count)) for _ in range(n_links)]
+    return [tuple(int(column[i]) for column in columns) for i in range(count)]
 
 
-def screened_candidates(start: tuple[int, ...], n_modules: int, screen, budget: int, restarts: int, refine: int,
+def screened_candidates(start: tuple[int, ...], n_modules: int, screen, budget: int, sample: int, refine: int,
                         seed: int):
-    """The coarse half of the modular search: `neighbourhood_search` on screening costs ``screen(assignments,
-    incumbent)`` from ``start`` (the rounded assignment) and ``restarts`` seeded random assignments, within
-    ``budget``. Returns (the ``refine`` best screened assignments that track and are `distinct_optima`, best
-    first; every (assignment, screening cost) in the order screened)."""
-    starts = [tuple(start), *random_assignments(restarts, len(start), n_modules, seed)]
-    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget)
+    """The coarse half of the modular search: ``start`` (the rounded assignment) and ``sample`` seeded
+    `spread_assignments` screened in one batch (``screen(assignments, incumbent)``), then `neighbourhood_search`
+    from them cheapest first, within ``budget`` screened in all. Returns (the ``refine`` best screened
+    assignments that track and are `distinct_optima`, best first; every (assignment, screening cost) in the
+    order screened)."""
+    starts = [tuple(start), *spread_assignments(sample, len(start), n_modules, seed)]
+    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget, cheapest_first=True)
     return distinct_optima([(a, c) for a, c in evaluated if np.isfinite(c)], refine), evaluated
 
 

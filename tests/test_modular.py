@@ -31,6 +31,7 @@ from designopt.modular import (
     nearest_modules,
     neighbourhood_search,
     screened_candidates,
+    spread_assignments,
 )
 from designopt.problem import problem_from_config
 
@@ -131,7 +132,7 @@ def test_modular_command_writes_every_stage(tmp_path):
     stages = set(summary["case"])
     assert {"continuous", "continuous_modular", "rounded", "modular", "fk"} <= stages
     screened = {c for c in stages if c.startswith("sc-")}  # the neighbourhood search's screened candidates
-    assert len(screened) == 30  # the budget, all spent: eight random restarts are more than 30 can finish
+    assert len(screened) == 30  # the budget, all spent: a sample of 5 and local searches from the best of it
     warm = summary[summary["stage"] == "warm"]  # neighbours of an incumbent: one more start, from its optimum
     assert len(warm) and warm["case"].str.startswith("sc-").all() and warm["case"].is_unique
     size = summary.groupby([summary["case"].str[:3], "stage"])["n_variables"].agg(set)
@@ -144,11 +145,15 @@ def test_modular_command_writes_every_stage(tmp_path):
     assert (nb[nb["stage"] == "explore"].groupby("case").size() == REFINE_STARTS).all()  # twice the default's starts
     rows = summary[summary["case"].isin(screened) & (summary["tracks"].astype(str) == "True")]
     costs = rows.groupby("case")["design_cost"].min()
-    third = costs.sort_values().iloc[min(3, len(costs)) - 1]
     table = pd.read_csv(run / "table.csv").set_index("stage")
     rounded = table.loc["modular", "modules"].replace("m", "").replace(" ", "")  # solved already: not again
-    assert all(costs["sc-" + c[3:]] <= third for c in refined)  # the best screened (ties either way)
-    assert len(refined | {f"nb-{rounded}"}) >= min(3, len(costs))
+    # the best screened optima, one assignment each: no two refined share a screening cost (to 1e-6), and every
+    # screened assignment cheaper than the dearest refined one shares its cost with a refined one (or the rounded)
+    kept = [costs["sc-" + c[3:]] for c in refined] + ([costs[f"sc-{rounded}"]] if f"sc-{rounded}" in costs else [])
+    assert all(abs(a - b) > 1e-6 * a for a, b in itertools.combinations(kept[: len(refined)], 2))
+    dearest = max(costs["sc-" + c[3:]] for c in refined)
+    assert all(any(abs(c - k) <= 1e-6 * k for k in kept) for c in costs[costs < dearest])
+    assert len(refined | {f"nb-{rounded}"}) >= min(3, len(set(np.round(costs.values, 6))))
     table = pd.read_csv(run / "table.csv").set_index("stage")
     # the search starts from the rounded assignment and never ends worse than its re-solve
     assert table.loc["neighbourhood", "design_cost"] <= table.loc["modular", "design_cost"] * (1 + 1e-9)
@@ -278,10 +283,37 @@ def test_refined_candidates_are_distinct_optima():
         return float(1.0 + sum(table[i, k] for i, k in enumerate(a[1:]))) * (1 + 1e-9 * (a[0] == 2))
 
     ranked, evaluated = screened_candidates((0, 0, 0, 0), 3, lambda b, _: [cost(a) for a in b], budget=81,
-                                            restarts=2, refine=4, seed=0)
+                                            sample=2, refine=4, seed=0)
     values = sorted({round(c, 6) for _, c in evaluated})[:4]
     assert [round(cost(a), 6) for a in ranked] == values
     assert len({a[1:] for a in ranked}) == 4  # four different robots, not one robot under four link-1 modules
     copies = [(a, c) for a, c in evaluated if a[1:] == ranked[0][1:]]
     assert len(copies) > 1 and distinct_optima(copies, 4) == [min(copies, key=lambda p: p[1])[0]]
     assert distinct_optima([((0,), 1.0), ((1,), 1.0 + 2e-6)], 2) == [(0,), (1,)]  # 2e-6 apart: two optima
+
+
+def test_spread_assignments_use_every_module_equally_often_on_every_link():
+    sample = spread_assignments(12, 6, 5, seed=7)
+    assert len(set(sample)) > 1 and sample == spread_assignments(12, 6, 5, seed=7) != spread_assignments(12, 6, 5, 8)
+    for link in range(6):
+        counts = np.bincount([a[link] for a in sample], minlength=5)
+        assert counts.max() - counts.min() <= 1 and counts.sum() == 12
+
+
+def test_the_local_searches_start_from_the_cheapest_screened_start():
+    """A deceptive 4-link cost: a wide shallow basin around all-zeros and a narrow deep one around (2, 2, 2, 2).
+    From the starts in the given order the budget runs out in the shallow basin; cheapest first, the search
+    starts next to the deep one and reaches it."""
+    deep = (2, 2, 2, 2)
+
+    def cost(a):
+        far = sum(x != y for x, y in zip(a, deep, strict=True))
+        return 0.1 * far if far <= 1 else 1.0 + sum(a)
+
+    starts = [(0, 0, 0, 0), (1, 1, 1, 1), (2, 2, 2, 0), (0, 1, 2, 3)]
+    evaluate = lambda batch, _: [cost(a) for a in batch]  # noqa: E731
+    best, value, _ = neighbourhood_search(starts, 4, evaluate, budget=20)
+    assert value >= 1.0  # in order: the shallow basin takes the budget
+    best, value, seen = neighbourhood_search(starts, 4, evaluate, budget=20, cheapest_first=True)
+    assert tuple(best) == deep and value == 0.0
+    assert [a for a, _ in seen[:4]] == starts  # the starts are screened first, as one batch

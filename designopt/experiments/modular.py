@@ -6,10 +6,11 @@ Stages, each written to summary.csv as a ``case``:
   rounded             every link replaced by its nearest module, evaluated on the stage-2 trajectory
   modular             modules fixed; placement and trajectory re-solved (the modular design)
   neighbourhood       beyond the paper: a search over module assignments, coarse to fine like the continuous one --
-                      a local search (one link's module changed at a time) from the rounded assignment and from
-                      seeded random ones, each candidate screened on a coarse sampling of the path (cases
+                      a local search (one link's module changed at a time) from the cheapest of the rounded
+                      assignment and a seeded sample spread over the catalogue (every module equally often on
+                      every link), each candidate screened on a coarse sampling of the path (cases
                       sc-<modules>; a neighbour of the incumbent also warm from the incumbent's screening
-                      optimum); the best screened searched on the full path with the default search at
+                      optimum); the best distinct screened optima searched on the full path with the default search at
                       `REFINE_STARTS` coarse starts (cases nb-<modules>)
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 
@@ -53,7 +54,7 @@ STAGES = ("continuous", "continuous_modular", "rounded", "modular", "neighbourho
 WEIGHT = 1.0e-3  # L_mod's weight in the objective
 WEIGHT_STUDY = (1.0e-4, 1.0e-3, 1.0e-2)
 NEIGHBOURHOOD_BUDGET = 300  # module assignments the neighbourhood search may screen
-NEIGHBOURHOOD_RESTARTS = 8  # seeded random assignments it starts from after the rounded one
+NEIGHBOURHOOD_SAMPLE = 1 / 6  # share of the budget: spread assignments screened with the rounded one, to start from
 NEIGHBOURHOOD_REFINE = 8  # best screened assignments re-solved on the full path
 SCREEN_WAYPOINTS = 10  # the screening's sampling of the path
 REFINE_STARTS = 160  # coarse starts of each best screened assignment's full-path search (the default search has 80)
@@ -217,15 +218,15 @@ def module_refine(search: Search) -> Search:
     return preset("default", seed=search.seed, init="reach", starts=REFINE_STARTS)
 
 
-def _module_search(setup, base, catalogue, placement, rounded, modular, budget, restarts=NEIGHBOURHOOD_RESTARTS,
-                   refine=NEIGHBOURHOOD_REFINE):
-    """The neighbourhood stage: a local search over assignments on screening costs, from the rounded assignment
-    and ``restarts`` seeded random ones, within ``budget`` screened assignments; then the ``refine`` best screened
-    searched on the full path (`module_refine`). Returns (best assignment, its solution, assignments
+def _module_search(setup, base, catalogue, placement, rounded, modular, budget, refine=NEIGHBOURHOOD_REFINE):
+    """The neighbourhood stage: a local search over assignments on screening costs within ``budget`` screened
+    assignments, from the cheapest of the rounded assignment and a sample spread over the catalogue (a
+    `NEIGHBOURHOOD_SAMPLE` share of the budget) on; then the ``refine`` best distinct screening optima searched on
+    the full path (`module_refine`). Returns (best assignment, its solution, assignments
     screened); never worse than the rounded assignment's re-solve ``modular``."""
     screen = ModuleCosts(setup, base, catalogue, placement, "sc-", module_screen(setup.search), SCREEN_WAYPOINTS)
-    ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget, restarts, refine,
-                                            setup.search.seed)
+    ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget,
+                                            round(budget * NEIGHBOURHOOD_SAMPLE), refine, setup.search.seed)
     full = ModuleCosts(setup, base, catalogue, placement, "nb-", module_refine(setup.search))
     full.best[tuple(rounded)] = modular  # already solved: the modular stage
     full(ranked)
