@@ -352,7 +352,7 @@ def modular(
     weight: Annotated[float, typer.Option("--weight", min=0.0, help="Weight of L_mod in the objective.")] = 1.0e-3,
     budget: Annotated[int, typer.Option("--budget", min=0, help="Module assignments the neighbourhood search may "
                                                                 "screen (0: no neighbourhood search).")] = 300,
-    refine: Annotated[int, typer.Option("--refine", min=1, help="Best screened assignments the neighbourhood "
+    refine: Annotated[int, typer.Option("--refine", min=1, help="Best distinct screening optima the neighbourhood "
                                                                 "search searches on the full path.")] = 8,
 ):
     """Modular design: continuous TO with L_mod, round links to modules, re-solve placement, search neighbouring
