@@ -55,7 +55,7 @@ WEIGHT = 1.0e-3  # L_mod's weight in the objective
 WEIGHT_STUDY = (1.0e-4, 1.0e-3, 1.0e-2)
 NEIGHBOURHOOD_BUDGET = 300  # module assignments the neighbourhood search may screen
 NEIGHBOURHOOD_SAMPLE = 1 / 6  # share of the budget: spread assignments screened with the rounded one, to start from
-NEIGHBOURHOOD_REFINE = 8  # best screened assignments re-solved on the full path
+NEIGHBOURHOOD_REFINE = 8  # best distinct screening optima re-solved on the full path
 SCREEN_WAYPOINTS = 10  # the screening's sampling of the path
 REFINE_STARTS = 160  # coarse starts of each best screened assignment's full-path search (the default search has 80)
 # w_lin (1/m^2) and w_ang of the similarity distance (SPEC §3)
