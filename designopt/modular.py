@@ -29,6 +29,7 @@ PAPER_MODULES = (  # Table II of the paper: (theta free, d, a, alpha)
 # Two screening costs this close (relative) are one optimum: IPOPT ends the same robot's optimum within ~4e-7 from
 # different starts, where the nearest distinct optima of the paper's catalogue seen in screens lay 9e-4 apart.
 SAME_OPTIMUM = 1.0e-6
+TWIST_TOL = 1.0e-9  # a twist within this (rad, through sin and cos) of 0 or pi keeps z parallel to the base's
 
 
 @dataclass(frozen=True)
@@ -99,26 +100,128 @@ def neighbours(assignment: tuple[int, ...], n_modules: int) -> list[tuple[int, .
             if k != assignment[i]]
 
 
+def lift_choices(assignment: tuple[int, ...], catalogue: Catalogue) -> list[list[tuple[int, float]]]:
+    """For every link, the modules that build the same robot in its place, each with the lift it adds (m).
+
+    A DH link is Rz(theta) Tz(d) Tx(a) Rx(alpha). While every twist before a link is 0 or pi, the link's z axis
+    is parallel to the base's (reversed by each pi), so its d translates the rest of the robot along base z by
+    the same vector at every joint angle: it lifts the robot, and a free placement z (W in B) absorbs the lift
+    exactly. This holds for every link up to and including the first twisted one (alpha not 0 or pi); there any
+    module with the same (a, alpha) builds the same robot, lifted by its signed d; past it only the module
+    itself. A P link's d moves, so a P catalogue has no lifts: each link's choice is its own module, lift 0.
+    """
+    if catalogue.joint_type != "R":
+        return [[(k, 0.0)] for k in assignment]
+    choices, sign, lifting = [], 1.0, True
+    for k in assignment:
+        _, a, alpha = catalogue.modules[k]
+        if lifting:
+            choices.append([(j, sign * d) for j, (d, aj, alj) in enumerate(catalogue.modules)
+                            if aj == a and math.cos(alj - alpha) > 1 - TWIST_TOL])
+            lifting = abs(math.sin(alpha)) <= TWIST_TOL
+            sign = sign if math.cos(alpha) > 0 else -sign
+        else:
+            choices.append([(k, 0.0)])
+    return choices
+
+
+def lift(assignment: tuple[int, ...], catalogue: Catalogue) -> float:
+    """How far (m, along base z) an assignment lifts the robot it builds (`lift_choices`)."""
+    return sum(dict(options)[k] for k, options in zip(assignment, lift_choices(assignment, catalogue), strict=True))
+
+
+def same_robot(assignment: tuple[int, ...], catalogue: Catalogue) -> tuple:
+    """A key equal for exactly the assignments that build one robot up to a lift along base z (`lift_choices`)."""
+    return tuple(tuple(sorted(j for j, _ in options)) if len(options) > 1 else options[0][0]
+                 for options in lift_choices(assignment, catalogue))
+
+
+def lifts(assignment: tuple[int, ...], catalogue: Catalogue) -> list[float]:
+    """Every lift (m) an assignment of the same robot can have, ascending."""
+    reached = {0.0}
+    for options in lift_choices(assignment, catalogue):
+        reached = {round(r + d, 12) for r in reached for _, d in options}
+    return sorted(reached)
+
+
+def lifted_assignment(assignment: tuple[int, ...], catalogue: Catalogue, target: float) -> tuple[int, ...] | None:
+    """An assignment of the same robot whose lift is ``target`` (m, to 1e-9), changing the fewest leading links
+    (the given one when its own lift is ``target``); None when no assignment of the robot has that lift."""
+    choices = lift_choices(assignment, catalogue)
+    reachable = [{0.0}]  # lifts the links from i on can add
+    for options in reversed(choices):
+        reachable.insert(0, {round(r + d, 12) for r in reachable[0] for _, d in options})
+    if not any(abs(r - target) <= 1e-9 for r in reachable[0]):
+        return None
+    picked, rest = [], target
+    for i, options in enumerate(choices):
+        own = [o for o in options if o[0] == assignment[i]]  # keep this link's module where the rest can follow
+        for k, d in own + [o for o in options if o[0] != assignment[i]]:
+            if any(abs(r - (rest - d)) <= 1e-9 for r in reachable[i + 1]):
+                picked.append(k)
+                rest -= d
+                break
+    return tuple(picked)
+
+
+def lifted_range(assignment: tuple[int, ...], catalogue: Catalogue, box: tuple[float, float]) -> tuple[float, float]:
+    """The placement z (m, W in B) over which the robot ``assignment`` builds fits the task as some assignment of
+    the same robot with its placement z inside ``box``: that assignment's z is this z plus its lift minus this
+    one's. One interval when no two neighbouring lifts lie further apart than the box is tall (`lifts_absorbed`)."""
+    own, reached = lift(assignment, catalogue), lifts(assignment, catalogue)
+    return box[0] - (reached[-1] - own), box[1] - (reached[0] - own)
+
+
+def within_box(assignment: tuple[int, ...], catalogue: Catalogue, z: float, box: tuple[float, float],
+               tol: float = 1e-6) -> tuple[tuple[int, ...], float]:
+    """The assignment of the same robot whose placement z lies in ``box`` (to ``tol``, m) when ``assignment``'s is
+    ``z``, and that z: ``assignment`` itself if its z is inside, else the one with the lift nearest its own."""
+    if box[0] - tol <= z <= box[1] + tol:
+        return tuple(assignment), z
+    own = lift(assignment, catalogue)
+    inside = [r for r in lifts(assignment, catalogue) if box[0] - tol <= z + r - own <= box[1] + tol]
+    if not inside:
+        raise ValueError(f"placement z {z} lies outside {box} for every assignment of this robot")
+    target = min(inside, key=lambda r: (abs(r - own), r))
+    return lifted_assignment(assignment, catalogue, target), z + target - own
+
+
+def lifts_absorbed(catalogue: Catalogue, box: tuple[float, float]) -> bool:
+    """Whether a placement z free in ``box`` absorbs every lift: the catalogue's d (or theta) span no more than the
+    box is tall, so the lifts of one robot lie no further apart than that and `lifted_range` is one interval."""
+    offsets = [m[0] for m in catalogue.modules]
+    return catalogue.joint_type == "R" and max(offsets) - min(offsets) <= box[1] - box[0]
+
+
 def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate, budget: int,
-                         cheapest_first: bool = False):
+                         cheapest_first: bool = False, same=None):
     """Best-improvement local search over module assignments, from each of ``starts`` in turn.
 
     ``evaluate(assignments, incumbent) -> costs`` solves a batch (NaN or inf: does not track), the neighbours of
-    ``incumbent`` (None for a start); an assignment is evaluated at most once. A step evaluates every neighbour of
-    the incumbent (one link's module changed) and moves to the cheapest if it beats the incumbent; a start ends
-    at a local optimum of this neighbourhood or when ``budget`` evaluations are spent. ``cheapest_first``: every
-    start is evaluated first, in one batch, and the local searches run from the cheapest start on (a start
-    inside a basin searched already costs nothing more). Returns (best assignment, its cost, every evaluation in
-    order).
+    ``incumbent`` (None for a start). ``same(assignment)`` (default: the assignment itself) is a key shared by
+    assignments that build one robot (`same_robot`): one of them is evaluated, the first met, and the others
+    take its cost for nothing; ``budget`` counts robots evaluated. A step evaluates every neighbour of the
+    incumbent (one link's module changed) and moves to the cheapest if it beats the incumbent; a start ends at a
+    local optimum of this neighbourhood or when the budget is spent. ``cheapest_first``: every start is
+    evaluated first, in one batch, and the local searches run from the cheapest start on (a start inside a basin
+    searched already costs nothing more). Returns (best assignment, its cost, every (assignment evaluated, cost)
+    in order: one per robot).
     """
-    seen: dict[tuple[int, ...], float] = {}
+    same = same or (lambda a: a)
+    seen: dict = {}  # robot -> (the assignment evaluated for it, its cost)
 
     def costs(batch, incumbent=None):
-        new = [a for a in dict.fromkeys(batch) if a not in seen][: max(budget - len(seen), 0)]
+        first: dict = {}  # each robot of the batch not evaluated yet, by its first assignment in the batch
+        for a in batch:
+            if same(a) not in seen:
+                first.setdefault(same(a), a)
+        new = list(first.items())[: max(budget - len(seen), 0)]
         if new:
-            values = evaluate(new, incumbent)
-            seen.update({a: (float(c) if np.isfinite(c) else np.inf) for a, c in zip(new, values, strict=True)})
-        return [seen.get(a, np.inf) for a in batch]
+            warm = None if incumbent is None else seen[same(incumbent)][0]
+            values = evaluate([a for _, a in new], warm)
+            seen.update({key: (a, float(c) if np.isfinite(c) else np.inf)
+                         for (key, a), c in zip(new, values, strict=True)})
+        return [seen[same(a)][1] if same(a) in seen else np.inf for a in batch]
 
     starts = [tuple(a) for a in starts]
     if cheapest_first:
@@ -134,8 +237,9 @@ def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate
             if values[k] >= cost:
                 break
             current, cost = around[k], values[k]
-    best = min(seen, key=seen.get)
-    return list(best), seen[best], list(seen.items())
+    evaluated = list(seen.values())
+    best, value = min(evaluated, key=lambda pair: pair[1])
+    return list(best), value, evaluated
 
 
 def spread_assignments(count: int, n_links: int, n_modules: int, seed: int) -> list[tuple[int, ...]]:
@@ -147,14 +251,14 @@ def spread_assignments(count: int, n_links: int, n_modules: int, seed: int) -> l
 
 
 def screened_candidates(start: tuple[int, ...], n_modules: int, screen, budget: int, sample: int, refine: int,
-                        seed: int):
+                        seed: int, same=None):
     """The coarse half of the modular search: ``start`` (the rounded assignment) and ``sample`` seeded
     `spread_assignments` screened in one batch (``screen(assignments, incumbent)``), then `neighbourhood_search`
-    from them cheapest first, within ``budget`` screened in all. Returns (the ``refine`` best screened
-    assignments that track and are `distinct_optima`, best first; every (assignment, screening cost) in the
-    order screened)."""
+    from them cheapest first, within ``budget`` robots screened in all (``same``: which assignments are one
+    robot, see `neighbourhood_search`). Returns (the ``refine`` best screened assignments that track and are
+    `distinct_optima`, best first; every (assignment, screening cost) in the order screened)."""
     starts = [tuple(start), *spread_assignments(sample, len(start), n_modules, seed)]
-    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget, cheapest_first=True)
+    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget, cheapest_first=True, same=same)
     return distinct_optima([(a, c) for a, c in evaluated if np.isfinite(c)], refine), evaluated
 
 

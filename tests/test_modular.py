@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 
@@ -21,17 +22,26 @@ from designopt.experiments.modular import (
     module_values,
     with_modular_cost,
 )
+from designopt.kinematics.chain import tool_pose
 from designopt.kinematics.joints import Role
 from designopt.modular import (
     Catalogue,
     check_catalogue,
     distance,
     distinct_optima,
+    lift,
+    lifted_assignment,
+    lifted_range,
+    lifts,
+    lifts_absorbed,
     modular_cost,
     nearest_modules,
     neighbourhood_search,
+    neighbours,
+    same_robot,
     screened_candidates,
     spread_assignments,
+    within_box,
 )
 from designopt.problem import problem_from_config
 
@@ -317,3 +327,128 @@ def test_the_local_searches_start_from_the_cheapest_screened_start():
     best, value, seen = neighbourhood_search(starts, 4, evaluate, budget=20, cheapest_first=True)
     assert tuple(best) == deep and value == 0.0
     assert [a for a, _ in seen[:4]] == starts  # the starts are screened first, as one batch
+
+
+@functools.lru_cache(maxsize=1)
+def robots_of_the_paper_catalogue() -> dict:
+    """Every assignment of the five paper modules on six links, grouped by `same_robot` (brute force)."""
+    groups: dict = {}
+    for a in itertools.product(range(5), repeat=6):
+        groups.setdefault(same_robot(a, CAT), []).append(a)
+    return groups
+
+
+def tool_poses(assignment, qs):
+    chain = chain_with_links([CAT.modules[k] for k in assignment])
+    return [np.array(tool_pose(chain, q, chain.design_values), float) for q in qs]
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.tuples(*[st.integers(0, 4)] * 6))
+def test_one_robot_is_one_tool_pose_up_to_its_lift(assignment):
+    """Closed-form truth: assignments `same_robot` calls one robot put the tool at the same pose up to a
+    translation along base z by their difference of lifts, at every joint angle; an assignment of another robot
+    does not (its tool poses differ by more than a translation along base z at some angles)."""
+    rng = np.random.default_rng(sum(assignment))
+    qs = rng.uniform(-np.pi, np.pi, (4, 6))
+    own = tool_poses(assignment, qs)
+    group = robots_of_the_paper_catalogue()[same_robot(assignment, CAT)]
+    assert assignment in group
+    for other in group:
+        shift = np.eye(4)
+        shift[2, 3] = lift(other, CAT) - lift(assignment, CAT)
+        assert all(np.allclose(p, shift @ o, atol=1e-12) for p, o in zip(tool_poses(other, qs), own, strict=True))
+    stranger = next(a for a in neighbours(assignment, 5) if same_robot(a, CAT) != same_robot(assignment, CAT))
+    gaps = [p[:3, 3] - o[:3, 3] for p, o in zip(tool_poses(stranger, qs), own, strict=True)]
+    rotations_equal = all(np.allclose(p[:3, :3], o[:3, :3]) for p, o in zip(tool_poses(stranger, qs), own, strict=True))
+    assert not (rotations_equal and np.allclose(gaps, gaps[0]) and np.allclose(np.array(gaps)[:, :2], 0))
+
+
+def test_lifts_ranges_and_the_member_inside_the_box_agree_with_brute_force():
+    box = (-1.0, 2.0)
+    assert lifts_absorbed(CAT, box) and not lifts_absorbed(CAT, (0.0, 0.5))
+    groups = robots_of_the_paper_catalogue()
+    assert len(groups[same_robot((0,) * 6, CAT)]) == 64  # a planar robot of m1/m4 links: 2^6 lifts of one robot
+    for a in [(0, 4, 0, 0, 0, 1), (3, 3, 1, 0, 3, 4), (2, 0, 3, 4, 3, 3), (1, 3, 3, 3, 3, 3)]:
+        group = groups[same_robot(a, CAT)]
+        truth = sorted({round(lift(b, CAT), 12) for b in group})
+        assert lifts(a, CAT) == truth
+        for r in truth:
+            b = lifted_assignment(a, CAT, r)
+            assert b in group and lift(b, CAT) == pytest.approx(r)
+        assert lifted_assignment(a, CAT, lift(a, CAT)) == a and lifted_assignment(a, CAT, truth[-1] + 0.25) is None
+        # the range of a's placement z is the union of every member's box, moved by the difference of lifts
+        lo, hi = lifted_range(a, CAT, box)
+        intervals = sorted((box[0] - (r - lift(a, CAT)), box[1] - (r - lift(a, CAT))) for r in truth)
+        assert (lo, hi) == pytest.approx((intervals[0][0], intervals[-1][1]))
+        assert all(nxt[0] <= cur[1] for cur, nxt in itertools.pairwise(intervals))  # one interval
+        for z in np.linspace(lo, hi, 13):
+            member, z_member = within_box(a, CAT, z, box)
+            assert member in group and box[0] - 1e-9 <= z_member <= box[1] + 1e-9
+            assert z_member - z == pytest.approx(lift(member, CAT) - lift(a, CAT))
+            if box[0] <= z <= box[1]:
+                assert member == a and z_member == z
+        with pytest.raises(ValueError, match="outside"):
+            within_box(a, CAT, hi + 0.1, box)
+
+
+def test_the_search_evaluates_one_assignment_per_robot():
+    """Link 1's module does not change the robot (``same`` drops it): one assignment of each robot is evaluated,
+    the budget counts robots, every step's incumbent is an evaluated assignment, and the optimum over robots is
+    found, as on the cost of the robots alone."""
+    rng = np.random.default_rng(11)
+    table = rng.uniform(0, 1, (4, 3))
+
+    def cost(a):
+        return float(sum(table[i, k] for i, k in enumerate(a) if i))
+
+    calls, incumbents = [], []
+
+    def evaluate(batch, incumbent):
+        calls.extend(batch)
+        incumbents.append(incumbent)
+        return [cost(a) for a in batch]
+
+    best, value, seen = neighbourhood_search([(0, 0, 0, 0)], 3, evaluate, budget=27, same=lambda a: a[1:])
+    truth = min(itertools.product(range(3), repeat=4), key=cost)
+    assert value == pytest.approx(cost(truth)) and tuple(best)[1:] == truth[1:]
+    assert len({a[1:] for a in calls}) == len(calls) == len(seen) <= 27  # one per robot
+    assert all(i is None or i in calls for i in incumbents)
+    calls.clear()
+    _, _, seen = neighbourhood_search([(0, 0, 0, 0)], 3, evaluate, budget=5, same=lambda a: a[1:])
+    assert len(calls) == len(seen) == 5
+
+
+def test_a_solution_as_built_keeps_its_metrics_with_its_placement_in_the_box():
+    """Invariant: a solution whose placement z lies outside the box, moved to the assignment of the same robot
+    whose z lies inside (`as_built`), tracks and costs the same (metrics evaluated afresh on the other robot),
+    for any joint trajectory; inside the box it is returned as it is."""
+    from designopt.evaluation import evaluate
+    from designopt.experiments.modular import as_built, lifted_modules
+    from designopt.solution import Solution
+    from designopt.transcriptions.base import RawResult
+    from designopt.transcriptions.trajectory import HermiteCubic
+
+    cfg = parse_config({"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 6}})
+    base, catalogue = problem_from_config(cfg), catalogue_from_config(cfg)
+    a = (0, 4, 0, 0, 0, 1)  # m1 m5 m1 m1 m1 m2: lift 0.5; m4 in place of m1 on link 1 lifts it 1 m more
+    problem = lifted_modules(base, list(a), catalogue, {})
+    z = problem.chain.joint("placement.z")
+    assert (z.lower, z.upper) == pytest.approx((-1.0 - 1.0, 2.0))
+    rng = np.random.default_rng(5)
+    n, m = problem.toolpath.n, problem.chain.n_moving
+    trajectory = HermiteCubic(problem.toolpath.t, rng.normal(size=(n, m)), rng.normal(size=(n, m)))
+    names = [j.name for j in problem.chain.design]
+    for z_value, expected in [(-1.6, (3, 4, 0, 0, 0, 1)), (0.3, a)]:
+        q_d = problem.chain.design_values.copy()
+        q_d[names.index("placement.z")] = z_value
+        raw = RawResult(q_d, trajectory, "x", True, 0, 0.0, 0.0, 0.0, 0, 0)
+        sol = Solution(problem, "to", raw, evaluate(problem, q_d, trajectory))
+        member, built = as_built(sol, a, base, catalogue, {})
+        assert member == expected
+        assert built.problem.chain.joint("link1.d").value == catalogue.modules[expected[0]][0]
+        placed = dict(zip([j.name for j in built.problem.chain.design], built.raw.q_d, strict=True))
+        assert placed["placement.z"] == pytest.approx(z_value + lift(expected, CAT) - lift(a, CAT))
+        assert -1.0 <= placed["placement.z"] <= 2.0
+        assert built.metrics.design_cost == pytest.approx(sol.metrics.design_cost, rel=1e-9)
+        assert built.metrics.max_position_error == pytest.approx(sol.metrics.max_position_error, rel=1e-9)

@@ -36,11 +36,15 @@ from designopt.kinematics.joints import Role
 from designopt.modular import (
     Catalogue,
     check_catalogue,
+    lifted_range,
+    lifts_absorbed,
     link_vectors,
     modular_cost,
     nearest_modules,
     neighbourhood_search,
+    same_robot,
     screened_candidates,
+    within_box,
 )
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
@@ -86,6 +90,18 @@ def fix_modules(problem: DesignProblem, assignment: list[int], catalogue: Catalo
     values = module_values(problem, assignment, catalogue)
     chain = problem.chain.with_roles(dict.fromkeys(values, Role.FIXED), {**values, **placement})
     return replace(problem, chain=chain).without_cost("modular")
+
+
+def lifted_modules(problem: DesignProblem, assignment: list[int], catalogue: Catalogue,
+                   placement: dict[str, float]) -> DesignProblem:
+    """`fix_modules`, with the placement z free over every value at which an assignment of the same robot keeps
+    it in the box (`lifted_range`): one solve answers for all of them."""
+    fixed = fix_modules(problem, assignment, catalogue, placement)
+    z = fixed.chain.joint("placement.z")
+    lower, upper = lifted_range(tuple(assignment), catalogue, (z.lower, z.upper))
+    joints = tuple(replace(j, lower=lower, upper=upper, value=min(max(j.value, lower), upper)) if j is z else j
+                   for j in fixed.chain.joints)
+    return replace(fixed, chain=replace(fixed.chain, joints=joints))
 
 
 def rounded_solution(sol: Solution, assignment: list[int], catalogue: Catalogue) -> Solution:
@@ -220,21 +236,49 @@ def module_refine(search: Search) -> Search:
 
 def _module_search(setup, base, catalogue, placement, rounded, modular, budget, refine=NEIGHBOURHOOD_REFINE):
     """The neighbourhood stage: a local search over assignments on screening costs within ``budget`` screened
-    assignments, from the cheapest of the rounded assignment and a sample spread over the catalogue (a
+    robots, from the cheapest of the rounded assignment and a sample spread over the catalogue (a
     `NEIGHBOURHOOD_SAMPLE` share of the budget) on; then the ``refine`` best distinct screening optima searched on
-    the full path (`module_refine`). Returns (best assignment, its solution, assignments
-    screened); never worse than the rounded assignment's re-solve ``modular``."""
-    screen = ModuleCosts(setup, base, catalogue, placement, "sc-", module_screen(setup.search), SCREEN_WAYPOINTS)
+    the full path (`module_refine`). When the placement z is free and absorbs lifts (`lifts_absorbed`), the
+    assignments that build one robot up to a lift along base z are one robot: screened once, solved with the
+    placement z any of them could take (`lifted_range`), and reported as the one whose placement lies in the box
+    (`within_box`). Returns (best assignment, its solution, robots screened); never worse than the rounded
+    assignment's re-solve ``modular``."""
+    z = base.chain.joint("placement.z")
+    absorbed = z.role is Role.DESIGN and lifts_absorbed(catalogue, (z.lower, z.upper))
+    same = partial(same_robot, catalogue=catalogue) if absorbed else None
+    screen = ModuleCosts(setup, base, catalogue, placement, "sc-", module_screen(setup.search), SCREEN_WAYPOINTS,
+                         absorbed)
     ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget,
-                                            round(budget * NEIGHBOURHOOD_SAMPLE), refine, setup.search.seed)
-    full = ModuleCosts(setup, base, catalogue, placement, "nb-", module_refine(setup.search))
+                                            round(budget * NEIGHBOURHOOD_SAMPLE), refine, setup.search.seed, same)
+    full = ModuleCosts(setup, base, catalogue, placement, "nb-", module_refine(setup.search), absorbed=absorbed)
     full.best[tuple(rounded)] = modular  # already solved: the modular stage
     full(ranked)
     solved = {a: sol for a, sol in full.best.items() if sol is not None and sol.metrics.tracks}
     if not solved:
         return list(rounded), modular, len(evaluated)
     best = min(solved, key=lambda a: solved[a].metrics.design_cost)
-    return list(best), solved[best], len(evaluated)
+    if not absorbed:
+        return list(best), solved[best], len(evaluated)
+    member, built = as_built(solved[best], best, base, catalogue, placement)
+    return list(member), built, len(evaluated)
+
+
+def as_built(sol: Solution, assignment, base, catalogue, placement) -> tuple[tuple[int, ...], Solution]:
+    """``sol`` (of ``assignment``, its placement z maybe outside the box) as the assignment of the same robot whose
+    placement z lies in the box (`within_box`): that assignment's `fix_modules` problem, its placement z moved by
+    the difference of lifts, the same joint trajectory; metrics evaluated afresh on that problem."""
+    problem = fix_modules(base, list(assignment), catalogue, placement)
+    z = problem.chain.joint("placement.z")
+    names = [j.name for j in problem.chain.design]
+    index = names.index("placement.z")
+    member, z_member = within_box(tuple(assignment), catalogue, float(sol.raw.q_d[index]), (z.lower, z.upper))
+    if member == tuple(assignment):
+        return member, sol
+    target = fix_modules(base, list(member), catalogue, placement)
+    q_d = np.array(sol.raw.q_d, float)
+    q_d[index] = z_member
+    raw = replace(sol.raw, q_d=q_d)
+    return member, Solution(target, sol.method, raw, evaluate(target, q_d, raw.trajectory))
 
 
 def _digits(assignment) -> str:
@@ -248,16 +292,18 @@ class ModuleCosts:
     batch in one search (cases ``<tag><module numbers>``); the neighbours of an ``incumbent`` also get one warm
     start from the incumbent's best solution (stage ``warm``): a module changed on one link moves the best
     placement and trajectory little, so a basin one family member found is tried on its neighbours. NaN when no
-    start tracks. ``best`` keeps each evaluated assignment's best solution."""
+    start tracks. ``absorbed``: the placement z is free over the range of every assignment of the same robot
+    (`lifted_modules`). ``best`` keeps each evaluated assignment's best solution."""
 
     def __init__(self, setup, base, catalogue, placement, tag, search: Search | None = None,
-                 waypoints: int | None = None):
+                 waypoints: int | None = None, absorbed: bool = False):
         self.setup, self.base, self.catalogue, self.placement, self.tag = setup, base, catalogue, placement, tag
-        self.search, self.waypoints = search or setup.search, waypoints
+        self.search, self.waypoints, self.absorbed = search or setup.search, waypoints, absorbed
         self.best: dict[tuple[int, ...], Solution | None] = {}
 
     def problem(self, assignment) -> DesignProblem:
-        fixed = fix_modules(self.base, list(assignment), self.catalogue, self.placement)
+        fixed = (lifted_modules if self.absorbed else fix_modules)(self.base, list(assignment), self.catalogue,
+                                                                  self.placement)
         return fixed if self.waypoints is None else coarse_problem(fixed, self.waypoints)
 
     def __call__(self, batch, incumbent=None):
