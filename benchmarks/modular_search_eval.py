@@ -8,7 +8,10 @@ enumeration's costs in place of the solves. Prints, per budget, the distribution
 full-path answer / the best full-path cost of the enumeration) and how many assignments it screened.
 
 The replay uses the enumeration's screening (search seed 0) for every seed: what it measures is the local
-search and its starts, not the screening's own seed-to-seed noise (real runs: docs/results.md).
+search and its starts, not the screening's own seed-to-seed noise (real runs: docs/results.md). Like the search,
+it evaluates one assignment per robot (`designopt.modular.same_robot`); the enumeration screened every assignment
+with its placement z in the box, so a robot costs what its first assignment met cost there, where the search
+solves it with the placement z of any assignment of the robot.
 
     .venv/bin/python benchmarks/modular_search_eval.py RUN_DIR [--first-seed 1000] [--seeds 20]
         [--budget 100 200 300] [--sample-share 0.1667] [--refine 8] [--start 213151]
@@ -17,6 +20,7 @@ search and its starts, not the screening's own seed-to-seed noise (real runs: do
 from __future__ import annotations
 
 import argparse
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +28,7 @@ import pandas as pd
 
 from designopt.config import load_config
 from designopt.experiments.modular import NEIGHBOURHOOD_SAMPLE, catalogue_from_config
-from designopt.modular import screened_candidates
+from designopt.modular import same_robot, screened_candidates
 from designopt.tables import COARSE_STAGES
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -42,13 +46,14 @@ def costs(run: Path) -> tuple[dict, dict]:
     return out[0], out[1]
 
 
-def replay(screen: dict, full: dict, start, seed: int, budget: int, share: float, refine: int, n_modules: int):
+def replay(screen: dict, full: dict, start, seed: int, budget: int, share: float, refine: int, catalogue):
     """(the best screening cost it found, the answer's full-path cost, assignments screened, refined candidates
     without a full-path cost). The answer is the best full-path cost among the refined candidates that the
     enumeration solved on the full path: an upper bound when some were not (they ranked below its refinement), NaN
     when none was. An assignment the screening did not track costs inf."""
-    ranked, evaluated = screened_candidates(start, n_modules, lambda b, _: [screen.get(a, np.inf) for a in b], budget,
-                                            round(budget * share), refine, seed)
+    screened = lambda batch, _: [screen.get(a, np.inf) for a in batch]  # noqa: E731
+    ranked, evaluated = screened_candidates(start, len(catalogue.modules), screened, budget, round(budget * share),
+                                            refine, seed, partial(same_robot, catalogue=catalogue))
     known = [full[a] for a in ranked if a in full]
     found = min(c for _, c in evaluated)
     return found, (min(known) if known else np.nan), len(evaluated), len(ranked) - len(known)
@@ -77,13 +82,13 @@ def main() -> None:
     screen, full = costs(Path(args.run))
     best_screen = min(screen.values())
     best = min(full.values()) if full else np.nan
-    n_modules = len(catalogue_from_config(load_config(args.config)).modules)
+    catalogue = catalogue_from_config(load_config(args.config))
     start = tuple(int(c) - 1 for c in args.start)
     print(f"{len(screen)} assignments track on the screening (best {best_screen:.6g}), {len(full)} solved on the full "
           f"path (best {best:.6g}); seeds {args.first_seed}-{args.first_seed + args.seeds - 1}")
     for budget in args.budget:
         found, answer, spent, unknown = zip(*[replay(screen, full, start, seed, budget, args.sample_share, args.refine,
-                                                     n_modules)
+                                                     catalogue)
                                               for seed in range(args.first_seed, args.first_seed + args.seeds)],
                                             strict=True)
         print(f"budget {budget} (screened {int(np.median(spent))} median): best screened found / best screening "

@@ -350,8 +350,10 @@ def modular(
     resume: ResumeOpt = False,
     jobs: JobsOpt = -1,
     weight: Annotated[float, typer.Option("--weight", min=0.0, help="Weight of L_mod in the objective.")] = 1.0e-3,
-    budget: Annotated[int, typer.Option("--budget", min=0, help="Module assignments the neighbourhood search may "
-                                                                "screen (0: no neighbourhood search).")] = 300,
+    budget: Annotated[int, typer.Option("--budget", min=0, help="Robots the neighbourhood search may screen (one "
+                                                                "assignment each: assignments that differ by a lift "
+                                                                "along base z, which the placement z takes up, are one "
+                                                                "robot; 0: no neighbourhood search).")] = 300,
     refine: Annotated[int, typer.Option("--refine", min=1, help="Best distinct screening optima the neighbourhood "
                                                                 "search searches on the full path.")] = 8,
 ):

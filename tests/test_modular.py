@@ -143,6 +143,8 @@ def test_modular_command_writes_every_stage(tmp_path):
     assert {"continuous", "continuous_modular", "rounded", "modular", "fk"} <= stages
     screened = {c for c in stages if c.startswith("sc-")}  # the neighbourhood search's screened candidates
     assert len(screened) == 30  # the budget, all spent: a sample of 5 and local searches from the best of it
+    robots = {same_robot(tuple(int(c) - 1 for c in case[3:]), CAT) for case in screened}
+    assert len(robots) == 30  # one assignment per robot: no two screened differ by a lift alone
     warm = summary[summary["stage"] == "warm"]  # neighbours of an incumbent: one more start, from its optimum
     assert len(warm) and warm["case"].str.startswith("sc-").all() and warm["case"].is_unique
     size = summary.groupby([summary["case"].str[:3], "stage"])["n_variables"].agg(set)
@@ -167,6 +169,10 @@ def test_modular_command_writes_every_stage(tmp_path):
     table = pd.read_csv(run / "table.csv").set_index("stage")
     # the search starts from the rounded assignment and never ends worse than its re-solve
     assert table.loc["neighbourhood", "design_cost"] <= table.loc["modular", "design_cost"] * (1 + 1e-9)
+    built = json.loads((run / "best-neighbourhood.json").read_text())  # the robot as built: its placement in the box
+    assert " ".join(f"m{[tuple(m) for m in CAT.modules].index((r['d'], r['a'], r['alpha'])) + 1}"
+                    for r in built["dh"]) == table.loc["neighbourhood", "modules"]
+    assert -1.0 <= built["design_joints"]["placement.z"] <= 2.0
     assert (run / "figures" / "module_pca.png").stat().st_size > 1000
     # the rounded assignment is the nearest modules of the continuous solution with L_mod (its file's links)
     continuous = json.loads((run / "best-continuous_modular.json").read_text())
@@ -341,6 +347,32 @@ def robots_of_the_paper_catalogue() -> dict:
 def tool_poses(assignment, qs):
     chain = chain_with_links([CAT.modules[k] for k in assignment])
     return [np.array(tool_pose(chain, q, chain.design_values), float) for q in qs]
+
+
+REVERSING = Catalogue("R", ((0.3, 0.5, math.pi), (0.2, 0.4, math.pi / 2), (0.7, 0.5, math.pi), (0.6, 0.4, math.pi / 2),
+                            (0.4, 0.5, 0.0)))
+
+
+def test_a_reversing_twist_lowers_what_follows():
+    """Closed-form truth on a catalogue with twists of pi (z reversed): every assignment of 4 links against every
+    other one of the same robot, tool poses equal up to their difference of lifts along base z."""
+    qs = np.random.default_rng(2).uniform(-np.pi, np.pi, (3, 4))
+
+    def poses(a):
+        chain = chain_with_links([REVERSING.modules[k] for k in a])
+        return [np.array(tool_pose(chain, q, chain.design_values), float) for q in qs]
+
+    groups: dict = {}
+    for a in itertools.product(range(5), repeat=4):
+        groups.setdefault(same_robot(a, REVERSING), []).append(a)
+    assert max(len(g) for g in groups.values()) > 4 and len(groups) < 5 ** 4
+    for group in groups.values():
+        first = poses(group[0])
+        for other in group[1:]:
+            shift = np.eye(4)
+            shift[2, 3] = lift(other, REVERSING) - lift(group[0], REVERSING)
+            assert all(np.allclose(p, shift @ o, atol=1e-12) for p, o in zip(poses(other), first, strict=True))
+    assert lift((0, 4, 1, 1), REVERSING) == pytest.approx(0.3 - 0.4 - 0.2)  # after a pi, d lowers
 
 
 @settings(max_examples=25, deadline=None)

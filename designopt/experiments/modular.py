@@ -11,7 +11,9 @@ Stages, each written to summary.csv as a ``case``:
                       every link), each candidate screened on a coarse sampling of the path (cases
                       sc-<modules>; a neighbour of the incumbent also warm from the incumbent's screening
                       optimum); the best distinct screened optima searched on the full path with the default search at
-                      `REFINE_STARTS` coarse starts (cases nb-<modules>)
+                      `REFINE_STARTS` coarse starts (cases nb-<modules>). One assignment per robot: assignments
+                      that differ by a lift along base z are solved once, with the placement z free over all of
+                      their boxes, and the best reported as the assignment whose placement z lies in the box
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 
 Every stage of the paper's method is a search of one problem with the config's search (the shipped config uses
@@ -167,7 +169,7 @@ def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progre
     if modular is not None and neighbourhood_budget:
         searched, best["neighbourhood"], screened = _module_search(s, base, catalogue, placement, assignment, modular,
                                                                     neighbourhood_budget, refine=neighbourhood_refine)
-        run.log(f"neighbourhood search: {screened} assignments screened, best {[k + 1 for k in searched]}")
+        run.log(f"neighbourhood search: {screened} robots screened, best {[k + 1 for k in searched]}")
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
         # not a solve: derived from the stage-2 best, so it is recorded once and recomputed on resume
