@@ -145,8 +145,9 @@ def lifts(assignment: tuple[int, ...], catalogue: Catalogue) -> list[float]:
 
 
 def lifted_assignment(assignment: tuple[int, ...], catalogue: Catalogue, target: float) -> tuple[int, ...] | None:
-    """An assignment of the same robot whose lift is ``target`` (m, to 1e-9), changing the fewest leading links
-    (the given one when its own lift is ``target``); None when no assignment of the robot has that lift."""
+    """An assignment of the same robot whose lift is ``target`` (m, to 1e-9), keeping each link's module, from the
+    base on, wherever the links after it can still make up the rest (the given one when its own lift is
+    ``target``); None when no assignment of the robot has that lift."""
     choices = lift_choices(assignment, catalogue)
     reachable = [{0.0}]  # lifts the links from i on can add
     for options in reversed(choices):
@@ -187,7 +188,7 @@ def within_box(assignment: tuple[int, ...], catalogue: Catalogue, z: float, box:
 
 
 def lifts_absorbed(catalogue: Catalogue, box: tuple[float, float]) -> bool:
-    """Whether a placement z free in ``box`` absorbs every lift: the catalogue's d (or theta) span no more than the
+    """Whether a placement z free in ``box`` absorbs every lift: a revolute catalogue whose d span no more than the
     box is tall, so the lifts of one robot lie no further apart than that and `lifted_range` is one interval."""
     offsets = [m[0] for m in catalogue.modules]
     return catalogue.joint_type == "R" and max(offsets) - min(offsets) <= box[1] - box[0]
