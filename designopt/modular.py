@@ -136,12 +136,17 @@ def same_robot(assignment: tuple[int, ...], catalogue: Catalogue) -> tuple:
                  for options in lift_choices(assignment, catalogue))
 
 
+def _reachable(choices: list[list[tuple[int, float]]]) -> list[set[float]]:
+    """For every link i (and one past the last), the lifts (m, to 1e-12) the links from i on can add."""
+    reachable = [{0.0}]
+    for options in reversed(choices):
+        reachable.insert(0, {round(r + d, 12) for r in reachable[0] for _, d in options})
+    return reachable
+
+
 def lifts(assignment: tuple[int, ...], catalogue: Catalogue) -> list[float]:
     """Every lift (m) an assignment of the same robot can have, ascending."""
-    reached = {0.0}
-    for options in lift_choices(assignment, catalogue):
-        reached = {round(r + d, 12) for r in reached for _, d in options}
-    return sorted(reached)
+    return sorted(_reachable(lift_choices(assignment, catalogue))[0])
 
 
 def lifted_assignment(assignment: tuple[int, ...], catalogue: Catalogue, target: float) -> tuple[int, ...] | None:
@@ -149,9 +154,7 @@ def lifted_assignment(assignment: tuple[int, ...], catalogue: Catalogue, target:
     base on, wherever the links after it can still make up the rest (the given one when its own lift is
     ``target``); None when no assignment of the robot has that lift."""
     choices = lift_choices(assignment, catalogue)
-    reachable = [{0.0}]  # lifts the links from i on can add
-    for options in reversed(choices):
-        reachable.insert(0, {round(r + d, 12) for r in reachable[0] for _, d in options})
+    reachable = _reachable(choices)
     if not any(abs(r - target) <= 1e-9 for r in reachable[0]):
         return None
     picked, rest = [], target

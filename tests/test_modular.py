@@ -344,8 +344,8 @@ def robots_of_the_paper_catalogue() -> dict:
     return groups
 
 
-def tool_poses(assignment, qs):
-    chain = chain_with_links([CAT.modules[k] for k in assignment])
+def tool_poses(assignment, qs, catalogue=CAT):
+    chain = chain_with_links([catalogue.modules[k] for k in assignment])
     return [np.array(tool_pose(chain, q, chain.design_values), float) for q in qs]
 
 
@@ -357,10 +357,7 @@ def test_a_reversing_twist_lowers_what_follows():
     """Closed-form truth on a catalogue with twists of pi (z reversed): every assignment of 4 links against every
     other one of the same robot, tool poses equal up to their difference of lifts along base z."""
     qs = np.random.default_rng(2).uniform(-np.pi, np.pi, (3, 4))
-
-    def poses(a):
-        chain = chain_with_links([REVERSING.modules[k] for k in a])
-        return [np.array(tool_pose(chain, q, chain.design_values), float) for q in qs]
+    poses = functools.partial(tool_poses, qs=qs, catalogue=REVERSING)
 
     groups: dict = {}
     for a in itertools.product(range(5), repeat=4):

@@ -269,10 +269,8 @@ def as_built(sol: Solution, assignment, base, catalogue, placement) -> tuple[tup
     """``sol`` (of ``assignment``, its placement z maybe outside the box) as the assignment of the same robot whose
     placement z lies in the box (`within_box`): that assignment's `fix_modules` problem, its placement z moved by
     the difference of lifts, the same joint trajectory; metrics evaluated afresh on that problem."""
-    problem = fix_modules(base, list(assignment), catalogue, placement)
-    z = problem.chain.joint("placement.z")
-    names = [j.name for j in problem.chain.design]
-    index = names.index("placement.z")
+    z = base.chain.joint("placement.z")  # its box: fix_modules keeps it
+    index = [j.name for j in sol.problem.chain.design].index("placement.z")
     member, z_member = within_box(tuple(assignment), catalogue, float(sol.raw.q_d[index]), (z.lower, z.upper))
     if member == tuple(assignment):
         return member, sol
