@@ -13,6 +13,7 @@ from designopt.style import METHOD_COLORS, fit_3d, label_3d
 
 METHOD_LABELS = {"to": "TO (collocation)", "fk": "FK (Whitman et al.)", "fk_continuous": "FK, bounded steps"}
 CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
+OPTIMA_SHOWN = 15  # distinct optima drawn in the search-progress figure, best first
 
 
 def full_path(summary: pd.DataFrame) -> pd.DataFrame:
@@ -203,11 +204,12 @@ def module_pca_figure(links: np.ndarray, modules: np.ndarray, assignment: list[i
     return save(fig, directory, "module_pca")
 
 
-def search_progress_figure(progress: pd.DataFrame, solution_set: pd.DataFrame, directory: Path) -> list[Path]:
-    """Best tracking cost so far against solves and solver seconds (would more budget help?), and the distinct
-    optima the search reached with how often."""
+def search_progress_figure(progress: pd.DataFrame, solution_set: pd.DataFrame, directory: Path,
+                           shown: int = OPTIMA_SHOWN) -> list[Path]:
+    """Best tracking cost so far against solves and solver seconds (would more budget help?), and the ``shown``
+    best distinct optima the search reached: each one's cost relative to the best, and how many solves reached it."""
     fig, (a1, a2, a3) = plt.subplots(1, 3, figsize=(11, 3.4))
-    from matplotlib.ticker import MaxNLocator
+    from matplotlib.ticker import FuncFormatter, MaxNLocator
 
     for ax, x, label in ((a1, "solves", "solves finished"), (a2, "solver_seconds", "solver time [s]")):
         ax.scatter(progress[x], progress["cost"], s=12, color="0.6", label="each tracking solve")
@@ -217,14 +219,19 @@ def search_progress_figure(progress: pd.DataFrame, solution_set: pd.DataFrame, d
         ax.set_yscale("log")
     a1.xaxis.set_major_locator(MaxNLocator(integer=True))
     a1.legend(fontsize=7)
-    if len(solution_set):
-        a3.bar(solution_set["optimum"].astype(str), solution_set["reached_by"], color="C2")
-        for x, (_, row) in enumerate(solution_set.iterrows()):
-            a3.annotate(f"{row['design_cost']:.2e}", (x, row["reached_by"]), ha="center", va="bottom", fontsize=7,
-                        rotation=90, xytext=(0, 2), textcoords="offset points")
-        a3.set_ylim(0, solution_set["reached_by"].max() * 1.6)
-    a3.yaxis.set_major_locator(MaxNLocator(integer=True))
-    a3.set_xlabel("distinct optimum (best first)")
-    a3.set_ylabel("solves that reached it")
+    best = solution_set.head(shown)
+    if len(best):
+        ratio = best["design_cost"] / solution_set["design_cost"].min()
+        a3.bar(np.arange(1, len(best) + 1), ratio, color="C2")
+        for x, (r, n) in enumerate(zip(ratio, best["reached_by"], strict=True), start=1):
+            a3.annotate(f"{n}", (x, r), ha="center", va="bottom", fontsize=6, xytext=(0, 1), textcoords="offset points")
+        a3.set_yscale("log")
+        a3.set_ylim(top=float(ratio.max()) * 1.5)
+        plain = FuncFormatter(lambda v, _: f"{v:g}")
+        a3.yaxis.set_major_formatter(plain)
+        a3.yaxis.set_minor_formatter(plain)
+    a3.xaxis.set_major_locator(MaxNLocator(integer=True))
+    a3.set_xlabel(f"distinct optimum, best first ({len(best)} of {len(solution_set)})")
+    a3.set_ylabel("design cost / best (solves reaching it)")
     fig.tight_layout()
     return save(fig, directory, "search_progress")

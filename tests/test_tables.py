@@ -30,3 +30,22 @@ def test_best_so_far_ignores_solves_that_do_not_track():
     table = best_so_far(summary)
     assert list(table["best_cost"]) == [3.0, 3.0, 2.0, 0.5]
     assert list(table["solver_seconds"]) == [1.0, 3.0, 3.5, 5.0]
+
+
+def test_search_progress_figure_draws_the_best_optima_relative_to_the_best(tmp_path, monkeypatch):
+    """A search that reached 40 distinct optima: the third panel shows the 15 best, each one's cost over the best's
+    and how many solves reached it, and says how many it leaves out."""
+    from designopt import plots_experiments
+
+    drawn = {}
+    monkeypatch.setattr(plots_experiments, "save", lambda fig, directory, stem: drawn.setdefault(stem, fig) and [])
+    costs = 2e-4 * 1.1 ** np.arange(40)
+    optima = pd.DataFrame({"optimum": np.arange(1, 41), "design_cost": costs, "reached_by": [3] + [1] * 39})
+    progress = best_so_far(pd.DataFrame({"tracks": ["True"] * 5, "design_cost": [5e-4, 3e-4, 4e-4, 2e-4, 6e-4],
+                                         "solve_time_s": [0.1] * 5}))
+    plots_experiments.search_progress_figure(progress, optima, tmp_path)
+    panel = drawn["search_progress"].axes[2]
+    heights = [bar.get_height() for bar in panel.patches]
+    assert np.allclose(heights, 1.1 ** np.arange(15))
+    assert [t.get_text() for t in panel.texts] == ["3"] + ["1"] * 14
+    assert "15 of 40" in panel.get_xlabel()
