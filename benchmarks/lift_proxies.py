@@ -17,6 +17,7 @@ and the best screen cost among the first 12 and 24 of the ranking (the default s
 from __future__ import annotations
 
 import argparse
+import json
 import os
 from pathlib import Path
 
@@ -65,7 +66,8 @@ def predictions_and_screen(job: Job, search, fine, sol) -> dict:
     profile, continuation = solve_setup(job, search, search.profile.warmed().capped(search.screen_max_iter))
     screened = run_task(Task(job.case, "screen", fine, job.transcription, profile, Lifted(sol), continuation))
     return {"coarse": sol.metrics.design_cost, "interp": interp, "proj": proj, "walk": walk,
-            "screen": screened.metrics.design_cost if screened.metrics.tracks else np.inf}
+            "screen": screened.metrics.design_cost if screened.metrics.tracks else np.inf, "seed": int(sol.raw.seed),
+            "design": [float(v) for v in sol.raw.q_d], "screened_design": [float(v) for v in screened.raw.q_d]}
 
 
 def main() -> None:
@@ -73,6 +75,7 @@ def main() -> None:
     parser.add_argument("run", type=Path, help="a finished run's directory (its solutions/explore-*.json)")
     parser.add_argument("--config", type=Path, default=Path("configs/milling.yaml"))
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--dump", type=Path, help="write every coarse optimum's row (costs, designs) as JSON here")
     parser.add_argument("--reference", type=float, help="a design cost on the screen's waypoints to count against "
                         "(e.g. the best design known solved there)")
     args = parser.parse_args()
@@ -83,6 +86,8 @@ def main() -> None:
     files = sorted(args.run.glob("solutions/explore-*.json"))
     sols = [s for s in (read_solution_for(coarse, Collocation(), f) for f in files) if s.metrics.tracks]
     rows = Parallel(n_jobs=args.jobs)(delayed(predictions_and_screen)(job, search, fine, s) for s in sols)
+    if args.dump:
+        args.dump.write_text(json.dumps(rows, default=float))
     screen = np.array([r["screen"] for r in rows])
     best, ok = screen.min(), np.isfinite(screen)
     print(f"{len(files)} coarse optima, {len(rows)} track; best screen cost {best:.4g}, "
