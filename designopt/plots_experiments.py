@@ -221,7 +221,7 @@ def search_progress_figure(progress: pd.DataFrame, solution_set: pd.DataFrame, d
     a1.legend(fontsize=7)
     best = solution_set.head(shown)
     if len(best):
-        ratio = best["design_cost"] / solution_set["design_cost"].min()
+        ratio = best["ratio_to_best"]
         a3.bar(np.arange(1, len(best) + 1), ratio, color="C2")
         for x, (r, n) in enumerate(zip(ratio, best["reached_by"], strict=True), start=1):
             a3.annotate(f"{n}", (x, r), ha="center", va="bottom", fontsize=6, xytext=(0, 1), textcoords="offset points")

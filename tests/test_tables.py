@@ -40,7 +40,8 @@ def test_search_progress_figure_draws_the_best_optima_relative_to_the_best(tmp_p
     drawn = {}
     monkeypatch.setattr(plots_experiments, "save", lambda fig, directory, stem: drawn.setdefault(stem, fig) and [])
     costs = 2e-4 * 1.1 ** np.arange(40)
-    optima = pd.DataFrame({"optimum": np.arange(1, 41), "design_cost": costs, "reached_by": [3] + [1] * 39})
+    optima = pd.DataFrame({"optimum": np.arange(1, 41), "design_cost": costs, "reached_by": [3] + [1] * 39,
+                           "ratio_to_best": costs / costs[0]})
     progress = best_so_far(pd.DataFrame({"tracks": ["True"] * 5, "design_cost": [5e-4, 3e-4, 4e-4, 2e-4, 6e-4],
                                          "solve_time_s": [0.1] * 5}))
     plots_experiments.search_progress_figure(progress, optima, tmp_path)
