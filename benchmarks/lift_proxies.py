@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+from dataclasses import replace
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -33,10 +34,9 @@ from designopt.initial_guess import ik_trajectory, residual_function  # noqa: E4
 from designopt.problem import problem_from_config  # noqa: E402
 from designopt.solution import read_solution_for  # noqa: E402
 from designopt.solve.search import Job  # noqa: E402
-from designopt.solve.starts import Lifted, lifted_guess  # noqa: E402
-from designopt.solve.strategies.coarse_to_fine import coarse_problem  # noqa: E402
-from designopt.solve.strategies.steps import solve_setup  # noqa: E402
-from designopt.solve.tasks import Task, run_task  # noqa: E402
+from designopt.solve.starts import lifted_guess  # noqa: E402
+from designopt.solve.strategies.coarse_to_fine import coarse_problem, lifted_tasks  # noqa: E402
+from designopt.solve.tasks import run_task  # noqa: E402
 from designopt.transcriptions import Collocation  # noqa: E402
 from designopt.transcriptions.trajectory import trajectory  # noqa: E402
 
@@ -57,14 +57,16 @@ def projected(problem, q_d: np.ndarray, Q: np.ndarray, iterations: int = 20) -> 
     return np.array(out)
 
 
-def predictions_and_screen(job: Job, search, fine, sol) -> dict:
+def predictions_and_screen(task) -> dict:
+    """A screen task's coarse optimum (``task.start``): its three predictions on the screen's waypoints, then the
+    task solved as the screen stage solves it."""
+    sol, fine = task.start.solution, task.problem
     guess = lifted_guess(fine, sol)
     t = fine.toolpath.t
     interp = evaluate(fine, guess.q_d, trajectory(t, guess.Q, guess.V)).design_cost
     proj = evaluate(fine, guess.q_d, trajectory(t, projected(fine, guess.q_d, guess.Q))).design_cost
     walk = evaluate(fine, guess.q_d, trajectory(t, ik_trajectory(fine, guess.q_d, guess.Q[0]))).design_cost
-    profile, continuation = solve_setup(job, search, search.profile.warmed().capped(search.screen_max_iter))
-    screened = run_task(Task(job.case, "screen", fine, job.transcription, profile, Lifted(sol), continuation))
+    screened = run_task(task)
     return {"coarse": sol.metrics.design_cost, "interp": interp, "proj": proj, "walk": walk,
             "screen": screened.metrics.design_cost if screened.metrics.tracks else np.inf, "seed": int(sol.raw.seed),
             "design": [float(v) for v in sol.raw.q_d], "screened_design": [float(v) for v in screened.raw.q_d]}
@@ -81,11 +83,13 @@ def main() -> None:
     args = parser.parse_args()
     cfg = load_config(args.config)
     problem, search = problem_from_config(cfg), search_from_config(cfg)
-    coarse, fine = coarse_problem(problem, search.explore_waypoints), coarse_problem(problem, search.screen_waypoints)
-    job = Job("lift_proxies", problem)
+    coarse = coarse_problem(problem, search.explore_waypoints)
     files = sorted(args.run.glob("solutions/explore-*.json"))
     sols = [s for s in (read_solution_for(coarse, Collocation(), f) for f in files) if s.metrics.tracks]
-    rows = Parallel(n_jobs=args.jobs)(delayed(predictions_and_screen)(job, search, fine, s) for s in sols)
+    # the screen stage's own tasks, for every coarse optimum (distinct 0: none merged)
+    tasks = lifted_tasks([Job("lift_proxies", problem)], [[(None, s) for s in sols]], len(sols), "screen",
+                         search.screen_waypoints, replace(search, distinct=0.0), search.screen_max_iter)
+    rows = Parallel(n_jobs=args.jobs)(delayed(predictions_and_screen)(task) for task in tasks)
     if args.dump:
         args.dump.write_text(json.dumps(rows, default=float))
     screen = np.array([r["screen"] for r in rows])
