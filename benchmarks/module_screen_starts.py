@@ -32,10 +32,12 @@ from designopt.solve.strategies.coarse_to_fine import coarse_problem  # noqa: E4
 from designopt.transcriptions import Collocation  # noqa: E402
 
 
-def solve_start(base, catalogue, placement, assignment: str, waypoints: int, start: int, seed: int, profile) -> float:
+def solve_start(base, catalogue, placement, assignment: str, waypoints: int, start: int, screen) -> float:
+    """Start ``start`` of the screen's search ``screen`` on one assignment's problem; its cost (inf: no tracking)."""
     problem = lifted_modules(base, [int(c) - 1 for c in assignment], catalogue, placement)
     problem = coarse_problem(problem, waypoints)
-    sol = solve_guess(problem, Collocation(), profile, initial_guess(problem, start, seed, 0.3, "reach"))
+    guess = initial_guess(problem, start, screen.seed, screen.perturbation, screen.init)
+    sol = solve_guess(problem, Collocation(), screen.profile, guess)
     return sol.metrics.design_cost if sol.metrics.tracks else np.inf
 
 
@@ -52,9 +54,9 @@ def main() -> None:
     base = problem_from_config(case_config(cfg, "combined"))
     catalogue = catalogue_from_config(cfg)
     placement = {j.name: j.value for j in base.chain.placement_joints}
-    profile = module_screen(preset("default", seed=args.seed)).profile
+    screen = module_screen(preset("default", seed=args.seed))  # the screen's starts and solver profile
     jobs = [(a, w, i) for a in args.assignments for w in args.waypoints for i in range(args.starts)]
-    costs = Parallel(n_jobs=args.jobs)(delayed(solve_start)(base, catalogue, placement, a, w, i, args.seed, profile)
+    costs = Parallel(n_jobs=args.jobs)(delayed(solve_start)(base, catalogue, placement, a, w, i, screen)
                                        for a, w, i in jobs)
     for a in args.assignments:
         for w in args.waypoints:
