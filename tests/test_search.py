@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 
 from designopt.config import parse_config
 from designopt.experiments.adapters import search_from_config
+from designopt.initial_guess import residual_function
 from designopt.problem import problem_from_config
 from designopt.solution import solve_and_evaluate
 from designopt.solve import (
@@ -32,6 +33,7 @@ from designopt.solve import (
     run_search,
     run_task,
 )
+from designopt.solve.starts import Rebranched
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
 from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import units
@@ -55,7 +57,7 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     (task, *_) = seeded_tasks(Job("", coarse_problem(problem_from_config(parse_config({})), 10)), "explore",
                               None, None, boxed, 2)
     assert task.start.spread == "box"
-    assert preset("quick", seed=2) == Search(starts=40, refine=2, seed=2, profile=PRESETS["quick"].profile)
+    assert preset("quick", seed=2) == Search(starts=40, rebranch=0, refine=2, seed=2, profile=PRESETS["quick"].profile)
 
 
 def test_a_coarse_path_is_a_subset_of_the_task():
@@ -156,7 +158,60 @@ def test_the_search_finds_the_optimum_a_single_start_misses(milling_12):
     best = searched.best[1]
     assert best is not None and best.metrics.tracks
     assert best.metrics.design_cost <= known * 1.001  # at least as good as the grid's best
-    assert len(searched.explore) == 8 and 1 <= len(searched.final) <= 2
+    # 8 seeded starts, then each of the (up to 8) best distinct optima once more on a new joint branch
+    assert 8 < len(searched.explore) <= 16 and 1 <= len(searched.final) <= 2
+
+
+def test_a_rebranched_start_keeps_the_design_on_a_new_branch(milling_12):
+    """A coarse optimum started again: the same design joints, first joints drawn over the whole circle and walked
+    by IK -- most walks reach the first waypoint (a drawn configuration by itself would not, within 1 mm), on
+    other branches than the optimum's own (joints radians away); the same (seed, index), the same start. (On a
+    coarse path the walk's later waypoints are far apart and a branch the design was not made for often loses
+    the path: the solve restores it.)"""
+    problem = coarse_problem(problem_from_config(parse_config(milling_12)), 6)
+    sol = solve(problem, max_iter=300)
+    assert sol.metrics.tracks
+    guesses = [Rebranched(sol, 3, i).guess(problem) for i in range(8)]
+    first = problem.toolpath.points_W[0]
+    reached = 0
+    for g in guesses:
+        assert np.array_equal(g.q_d, sol.raw.q_d)
+        r = np.array(residual_function(problem)(g.Q[0], g.q_d, first)[0]).ravel()
+        reached += np.linalg.norm(r[:3]) < problem.position_tol and np.linalg.norm(r[3:]) < problem.axis_tol
+    assert reached >= 4
+    assert min(np.abs(g.Q[0] - sol.raw.Q[0]).max() for g in guesses) > 1.0
+    assert np.array_equal(Rebranched(sol, 3, 5).guess(problem).Q, guesses[5].Q)
+    assert Rebranched(sol, 3, 5).number == 3005
+
+
+def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
+    """``rebranch``: after the seeded starts, the ``rebranch`` best distinct coarse optima, ``starts // rebranch``
+    starts each, numbered after the seeded ones, on the same coarse problem and cap; all pooled for the screen.
+    ``rebranch`` 0: no second round."""
+    problem = problem_from_config(parse_config(milling_12))
+    stages = []
+
+    def execute(tasks):
+        done = [(t, run_task(t)) for t in tasks]
+        stages.append(done)
+        return done
+
+    search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=2, screen_waypoints=0, refine=1,
+                    profile=SolverProfile(max_iter=200))
+    (searched,) = run_search([Job("", problem)], search, execute)
+    first, second = stages[0], stages[1]
+    assert [t.start.number for t, _ in first] == [0, 1, 2, 3]
+    leaders = [first[i][1] for i in distinct_best([s for _, s in first], 2, search.distinct)]
+    assert len(second) == 2 * len(leaders) and search.rebranch_starts == 2
+    assert [t.start.number for t, _ in second] == list(range(4, 4 + len(second)))
+    for k, (task, _) in enumerate(second):
+        assert isinstance(task.start, Rebranched) and task.start.solution is leaders[k // 2]
+        assert task.stage == "explore" and task.problem.toolpath.n == 6 and task.profile.max_iter == 100
+    assert len(searched.explore) == 4 + len(second)
+
+    stages.clear()
+    (searched,) = run_search([Job("", problem)], replace(search, rebranch=0), execute)
+    assert [t.stage for t, _ in stages[1]] == ["refine"] and len(searched.explore) == 4
 
 
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
@@ -164,8 +219,8 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     max_iter: a screening solve only ranks, so a stalling one must not take the full budget (design only stalls
     there)."""
     problem = problem_from_config(parse_config(milling_12))
-    search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, screen_waypoints=9, screen=3,
-                    screen_max_iter=25, refine=1, profile=SolverProfile(max_iter=300))
+    search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
+                    screen_max_iter=25, refine=1, profile=SolverProfile(max_iter=300))  # rebranch: its own test
     done = []
 
     def execute(tasks):

@@ -1,7 +1,8 @@
-"""Where a solve starts: a seeded start (`Seeded`), or a solution of another sampling of the same task (`Lifted`).
+"""Where a solve starts: a seeded start (`Seeded`), a solution of another sampling of the same task (`Lifted`), or a
+coarse optimum's design on a new joint branch (`Rebranched`).
 
 Every start has a ``number`` that identifies it in a run's files (the seed column of summary.csv): seed * 1000 +
-index for a seeded start, the lifted solution's number for a lifted one.
+index for a seeded or rebranched start, the lifted solution's number for a lifted one.
 """
 
 from __future__ import annotations
@@ -50,6 +51,28 @@ class Lifted:
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
         return lifted_guess(problem, self.solution)
+
+
+@dataclass(frozen=True, eq=False)
+class Rebranched:
+    """A coarse optimum started again on a new joint branch: its design joints, and start ``index`` of ``seed``'s
+    first configuration drawn over the whole circle (revolute joints in [-pi, pi] rad), walked along the path by
+    IK (``init``). A design's best basin is often on a branch its own start never visits (a folded posture, the
+    tool near every joint axis): the design and its branch have to be found together."""
+
+    solution: object  # designopt.solution.Solution
+    seed: int
+    index: int
+    init: str = "ik"
+
+    @property
+    def number(self) -> int:
+        return self.seed * 1000 + self.index
+
+    def guess(self, problem: DesignProblem) -> InitialGuess:
+        # with a design given, spread "box" only sets the first joints' range: the whole circle
+        return initial_guess(problem, self.index, self.seed, 0.0, self.init, np.asarray(self.solution.raw.q_d, float),
+                             "box")
 
 
 def lifted_guess(problem: DesignProblem, solution) -> InitialGuess:

@@ -23,7 +23,7 @@ class Task:
     problem: DesignProblem
     transcription: object
     profile: SolverProfile
-    start: object  # designopt.solve.starts.Seeded | Lifted
+    start: object  # designopt.solve.starts.Seeded | Lifted | Rebranched
     continuation: object | None = None  # e.g. designopt.solve.strategies.continuation.HoldDegenerate
 
     @property

@@ -6,7 +6,10 @@ design optimal for the full path. Stages, each across every problem:
 
 1. ``explore``: ``search.starts`` cold seeded starts of the *coarse problem* -- the same robot, placement, costs and
    cell on ``explore_waypoints`` of the path's waypoints (`coarse_problem`) -- each capped at
-   ``explore_max_iter``. A coarse solve costs about a tenth of a full one.
+   ``explore_max_iter``. A coarse solve costs about a tenth of a full one. Then the ``rebranch`` best distinct
+   coarse optima are each started again ``starts // rebranch`` times with their design on a new joint branch
+   (first joints over the whole circle, `Rebranched`), explored alike and pooled with the first round: a start lands in
+   the best basin only when its design and its branch both fit, and good designs are where to look for branches.
 2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    optima lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter`` and ranked again there:
    the coarse ranking alone often puts a design that lifts badly ahead of one that lifts well.
@@ -21,7 +24,7 @@ from dataclasses import replace
 from designopt.problem import DesignProblem
 from designopt.solve.optima import distinct_best
 from designopt.solve.search import Searched, by_job
-from designopt.solve.starts import Lifted
+from designopt.solve.starts import Lifted, Rebranched
 from designopt.solve.strategies.steps import seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
@@ -44,6 +47,22 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     return tasks
 
 
+def rebranched_tasks(jobs, found, search) -> list[Task]:
+    """For every job, its ``search.rebranch`` best distinct coarse optima each started ``search.rebranch_starts``
+    (``starts // rebranch``) times on a new joint branch, on the same coarse problem and profile as the
+    exploration; start indices follow the exploration's (``search.starts`` onwards)."""
+    tasks, m = [], search.rebranch_starts
+    for job, done in zip(jobs, found, strict=True):
+        coarse = coarse_problem(job.problem, search.explore_waypoints)
+        profile, continuation = solve_setup(job, search, search.profile.capped(search.explore_max_iter))
+        leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct)
+        for k, i in enumerate(leaders):
+            for j in range(m):
+                start = Rebranched(done[i][1], search.seed, search.starts + k * m + j, search.init)
+                tasks.append(Task(job.case, "explore", coarse, job.transcription, profile, start, continuation))
+    return tasks
+
+
 def plan(jobs, search):
     explore = []
     for job in jobs:
@@ -51,6 +70,9 @@ def plan(jobs, search):
         explore += seeded_tasks(job, "explore", coarse, search.profile.capped(search.explore_max_iter), search,
                                 search.starts)
     explored = by_job(jobs, (yield explore))
+    if search.rebranch:
+        again = by_job(jobs, (yield rebranched_tasks(jobs, explored, search)))
+        explored = [first + more for first, more in zip(explored, again, strict=True)]
     candidates = explored
     screened = [k for k, job in enumerate(jobs) if 0 < search.screen_waypoints < job.problem.toolpath.n]
     if screened:
