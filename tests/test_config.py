@@ -9,7 +9,8 @@ import pytest
 from designopt.config import ConfigError, dump_config, load_config, parse_config
 from designopt.problem import problem_from_config
 
-CONFIGS = sorted(Path(__file__).resolve().parent.parent.joinpath("configs").glob("*.yaml"))
+CONFIGS = sorted(p for p in Path(__file__).resolve().parent.parent.joinpath("configs").glob("*.yaml")
+                 if not p.name.startswith("."))  # not benchmarks/search_seeds.py's per-seed copies
 
 
 @pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.name)
