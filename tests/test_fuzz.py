@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 from cli.main import app
 
 ROOT = Path(__file__).resolve().parent.parent
-CONFIGS = sorted((ROOT / "configs").glob("*.yaml"))
+CONFIGS = sorted(p for p in (ROOT / "configs").glob("*.yaml") if not p.name.startswith("."))  # not per-seed copies
 runner = CliRunner()
 
 # Values a user (or a typo) might put anywhere: wrong types, non-finite and extreme numbers, small integers
