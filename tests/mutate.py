@@ -103,6 +103,12 @@ MUTATIONS = [
              "q_d=np.asarray(solution.raw.q_d, float)", "q_d=problem.chain.design_values"),
     Mutation("screening ignores its iteration cap", "designopt/solve/strategies/coarse_to_fine.py",
              "search, search.screen_max_iter)", "search)"),
+    Mutation("a rebranched start draws its first joints within +-pi/2 (the seeded starts' range)",
+             "designopt/solve/starts.py", '"box")', '"perturb")'),
+    Mutation("the second round left out of the screen's pool", "designopt/solve/strategies/coarse_to_fine.py",
+             "explored = [first + more for first, more in", "explored = [first for first, more in"),
+    Mutation("rebranched starts numbered over the seeded ones", "designopt/solve/strategies/coarse_to_fine.py",
+             "search.seed, search.starts + k * m + j,", "search.seed, k * m + j,"),
     # degenerate designs (issue 12, cause 3)
     Mutation("a moving target's row held once", "designopt/transcriptions/degeneracy.py",
              "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e-12:",
