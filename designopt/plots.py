@@ -181,15 +181,23 @@ def force_deflection_figure(sol: Solution):
     return fig
 
 
-def solution_figures(sol: Solution, directory: Path) -> list[Path]:
+SOLUTION_FIGURES = {"robot": robot_figure, "joints": joint_figure, "deformation": deformation_figure,
+                    "force_deflection": force_deflection_figure}
+
+
+def solution_figure_names(sol: Solution) -> list[str]:
     """The standard figures of one solution (and the force breakdown when the force has parts)."""
-    out = []
-    out += save(robot_figure(sol), directory, "robot")
-    out += save(joint_figure(sol), directory, "joints")
-    out += save(deformation_figure(sol), directory, "deformation")
-    if sol.problem.toolpath.force_parts:
-        out += save(force_deflection_figure(sol), directory, "force_deflection")
-    return out
+    return [name for name in SOLUTION_FIGURES if name != "force_deflection" or sol.problem.toolpath.force_parts]
+
+
+def solution_figure(sol: Solution, directory: Path, name: str) -> list[Path]:
+    """One of the standard figures of a solution (`SOLUTION_FIGURES`), as ``name``.png and .pdf."""
+    return save(SOLUTION_FIGURES[name](sol), directory, name)
+
+
+def solution_figures(sol: Solution, directory: Path) -> list[Path]:
+    """The standard figures of one solution, one after the other."""
+    return [path for name in solution_figure_names(sol) for path in solution_figure(sol, directory, name)]
 
 
 def render_figure(sol: Solution, frames: int = 6):

@@ -24,7 +24,8 @@ def finished_run(tmp_path_factory):
     config = root / "gantry.yaml"
     cfg = gantry_config(design=["a", "x", "z"], search={"preset": "quick", "starts": 3})
     config.write_text(yaml.safe_dump(cfg))
-    result = runner.invoke(app, ["run", str(config), "--out", str(root / "results"), "--name", "t", "--jobs", "1"])
+    # two workers: the search's solves and the figures side by side (`runs.draw`)
+    result = runner.invoke(app, ["run", str(config), "--out", str(root / "results"), "--name", "t", "--jobs", "2"])
     return result, root / "results" / "gantry" / "t"
 
 

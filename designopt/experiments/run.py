@@ -9,7 +9,7 @@ import pandas as pd
 
 from designopt.config import Config, dump_config
 from designopt.experiments.adapters import search_from_config
-from designopt.experiments.runs import Executor, Progress
+from designopt.experiments.runs import Executor, Progress, draw
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
@@ -57,22 +57,22 @@ def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, pro
     solutions = [sol for _, sol in searched.explore + searched.final]
     optima = searched_set(searched)
     optima.to_csv(run.path / "solution_set.csv", index=False)
-    if figures:
-        from designopt import plots_experiments
-
-        explored = summary[summary["stage"] == "explore"] if searched.explore else summary
-        plots_experiments.search_progress_figure(best_so_far(explored.reset_index(drop=True)), optima, run.figures)
     if best is not None:
         write_solution(best, run.path / "best.json")
         run.log(f"best: seed {best.raw.seed}, design cost {best.metrics.design_cost:.6g}; {len(optima)} distinct "
                 f"optima among {len(solutions)} solves")
-        if figures:
-            from designopt import plots
-            from designopt.view import write_view
-
-            plots.solution_figures(best, run.figures)
-            write_view(best, run.path / "view.html")
     else:
         run.log("no start tracks the path")
+    if figures:
+        from designopt import plots, plots_experiments
+        from designopt.view import write_view
+
+        explored = summary[summary["stage"] == "explore"] if searched.explore else summary
+        calls = [(plots_experiments.search_progress_figure,
+                  (best_so_far(explored.reset_index(drop=True)), optima, run.figures))]
+        if best is not None:
+            calls += [(plots.solution_figure, (best, run.figures, name)) for name in plots.solution_figure_names(best)]
+            calls.append((write_view, (best, run.path / "view.html")))
+        draw(calls, jobs)
     return RunResult(run, problem, [sol for _, sol in searched.final], [sol for _, sol in searched.explore], best,
                      summary, optima)

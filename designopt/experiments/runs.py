@@ -35,6 +35,19 @@ class Silent:
         pass
 
 
+def draw(calls: list[tuple], jobs: int | None) -> None:
+    """Figures drawn side by side: each call (function, args) writes its own files, on this machine's cores as
+    `fan_out` would use them (``jobs`` -1: every core), or one after the other here (``jobs`` 1 or None: a
+    cluster's workers would write the files on their own machines)."""
+    if jobs in (None, 1) or len(calls) <= 1:
+        for fn, args in calls:
+            fn(*args)
+        return
+    from joblib import Parallel, delayed, effective_n_jobs
+
+    Parallel(n_jobs=min(len(calls), effective_n_jobs(jobs)), backend="loky")(delayed(fn)(*args) for fn, args in calls)
+
+
 def record(run: RunDirectory, task: Task, sol: Solution, experiment: str) -> None:
     """Write one solution file (atomically), then its summary row: a row always has its file."""
     write_solution(sol, run.path / task.file_name)
