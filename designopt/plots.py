@@ -185,19 +185,17 @@ SOLUTION_FIGURES = {"robot": robot_figure, "joints": joint_figure, "deformation"
                     "force_deflection": force_deflection_figure}
 
 
-def solution_figure_names(sol: Solution) -> list[str]:
-    """The standard figures of one solution (and the force breakdown when the force has parts)."""
-    return [name for name in SOLUTION_FIGURES if name != "force_deflection" or sol.problem.toolpath.force_parts]
-
-
 def solution_figure(sol: Solution, directory: Path, name: str) -> list[Path]:
-    """One of the standard figures of a solution (`SOLUTION_FIGURES`), as ``name``.png and .pdf."""
+    """One of the standard figures of a solution (`SOLUTION_FIGURES`), as ``name``.png and .pdf; none where it
+    does not apply (the force breakdown of a force without parts)."""
+    if name == "force_deflection" and not sol.problem.toolpath.force_parts:
+        return []
     return save(SOLUTION_FIGURES[name](sol), directory, name)
 
 
 def solution_figures(sol: Solution, directory: Path) -> list[Path]:
     """The standard figures of one solution, one after the other."""
-    return [path for name in solution_figure_names(sol) for path in solution_figure(sol, directory, name)]
+    return [path for name in SOLUTION_FIGURES for path in solution_figure(sol, directory, name)]
 
 
 def render_figure(sol: Solution, frames: int = 6):

@@ -188,3 +188,12 @@ def test_every_best_design_known_checks_out():
     modules = set(catalogue_from_config(load_config(root / "configs" / "modular.yaml")).modules)
     modular = json.loads(kept[[p.name for p in kept].index("modular_best_known.json")].read_text())
     assert all((row["d"], row["a"], row["alpha"]) in modules for row in modular["dh"])
+
+
+def test_a_run_draws_every_standard_figure_of_its_best_solution():
+    """The run plans its figures by name (so that it needs no matplotlib itself): the names it plans are the ones
+    `designopt.plots` draws."""
+    from designopt import plots
+    from designopt.experiments import run
+
+    assert run.SOLUTION_FIGURES == tuple(plots.SOLUTION_FIGURES)

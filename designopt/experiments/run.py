@@ -9,7 +9,7 @@ import pandas as pd
 
 from designopt.config import Config, dump_config
 from designopt.experiments.adapters import search_from_config
-from designopt.experiments.runs import Executor, Progress, draw
+from designopt.experiments.runs import Drawing, Executor, Progress, draw
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
@@ -27,6 +27,10 @@ def searched_set(searched: Searched) -> pd.DataFrame:
     table["full_path_cost"] = [min((refined[int(x)] for x in seeds.split() if int(x) in refined), default=float("nan"))
                                for seeds in table["seeds"].astype(str)]
     return table
+
+
+# a run's standard figures of its best solution (`designopt.plots.SOLUTION_FIGURES`; each drawn where it applies)
+SOLUTION_FIGURES = ("robot", "joints", "deformation", "force_deflection")
 
 
 @dataclass(frozen=True)
@@ -64,15 +68,13 @@ def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, pro
     else:
         run.log("no start tracks the path")
     if figures:
-        from designopt import plots, plots_experiments
-        from designopt.view import write_view
-
         explored = summary[summary["stage"] == "explore"] if searched.explore else summary
-        calls = [(plots_experiments.search_progress_figure,
-                  (best_so_far(explored.reset_index(drop=True)), optima, run.figures))]
+        drawings = [Drawing("designopt.plots_experiments", "search_progress_figure",
+                            (best_so_far(explored.reset_index(drop=True)), optima, run.figures))]
         if best is not None:
-            calls += [(plots.solution_figure, (best, run.figures, name)) for name in plots.solution_figure_names(best)]
-            calls.append((write_view, (best, run.path / "view.html")))
-        draw(calls, jobs)
+            drawings += [Drawing("designopt.plots", "solution_figure", (best, run.figures, name))
+                         for name in SOLUTION_FIGURES]
+            drawings.append(Drawing("designopt.view", "write_view", (best, run.path / "view.html")))
+        draw(drawings, jobs)
     return RunResult(run, problem, [sol for _, sol in searched.final], [sol for _, sol in searched.explore], best,
                      summary, optima)
