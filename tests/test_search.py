@@ -206,7 +206,8 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
     assert [t.start.number for t, _ in second] == list(range(4, 4 + len(second)))
     for k, (task, _) in enumerate(second):
         assert isinstance(task.start, Rebranched) and task.start.solution is leaders[k // 2]
-        assert task.stage == "explore" and task.problem.toolpath.n == 6 and task.profile.max_iter == 100
+        assert task.stage == "explore" and task.problem is first[0][0].problem and task.profile is first[0][0].profile
+        assert task.problem.toolpath.n == 6 and task.profile.max_iter == 100
     assert len(searched.explore) == 4 + len(second)
 
     stages.clear()

@@ -47,19 +47,19 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     return tasks
 
 
-def rebranched_tasks(jobs, found, search) -> list[Task]:
-    """For every job, its ``search.rebranch`` best distinct coarse optima each started ``search.rebranch_starts``
-    (``starts // rebranch``) times on a new joint branch, on the same coarse problem and profile as the
-    exploration; start indices follow the exploration's (``search.starts`` onwards)."""
+def rebranched_tasks(found, search) -> list[Task]:
+    """For every job's exploration (its (task, solution) pairs), its ``search.rebranch`` best distinct coarse optima
+    each started ``search.rebranch_starts`` (``starts // rebranch``) times on a new joint branch, as the task that
+    found it (the same coarse problem, profile and continuation); start indices follow the exploration's
+    (``search.starts`` onwards)."""
     tasks, m = [], search.rebranch_starts
-    for job, done in zip(jobs, found, strict=True):
-        coarse = coarse_problem(job.problem, search.explore_waypoints)
-        profile, continuation = solve_setup(job, search, search.profile.capped(search.explore_max_iter))
+    for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct)
         for k, i in enumerate(leaders):
+            first, sol = done[i]
             for j in range(m):
-                start = Rebranched(done[i][1], search.seed, search.starts + k * m + j, search.init)
-                tasks.append(Task(job.case, "explore", coarse, job.transcription, profile, start, continuation))
+                start = Rebranched(sol, search.seed, search.starts + k * m + j, search.init)
+                tasks.append(replace(first, start=start))
     return tasks
 
 
@@ -71,7 +71,7 @@ def plan(jobs, search):
                                 search.starts)
     explored = by_job(jobs, (yield explore))
     if search.rebranch:
-        again = by_job(jobs, (yield rebranched_tasks(jobs, explored, search)))
+        again = by_job(jobs, (yield rebranched_tasks(explored, search)))
         explored = [first + more for first, more in zip(explored, again, strict=True)]
     candidates = explored
     screened = [k for k, job in enumerate(jobs) if 0 < search.screen_waypoints < job.problem.toolpath.n]
