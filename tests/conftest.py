@@ -4,6 +4,7 @@ solve one of them."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,6 +12,10 @@ import pytest
 from designopt.config import parse_config
 from designopt.problem import problem_from_config
 from designopt.solve import Seeded, SolverProfile, solve_guess, solve_one
+
+# The configs the project ships (not benchmarks/search_seeds.py's per-seed copies beside them, `.bench-seed*.yaml`)
+SHIPPED_CONFIGS = sorted(p for p in (Path(__file__).resolve().parent.parent / "configs").glob("*.yaml")
+                         if not p.name.startswith("."))
 
 # A Cartesian gantry in standard DH: link 1 moves along z0, link 2 along z1 = y0, link 3 along z2 = x0.
 GANTRY_DH = [

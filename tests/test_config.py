@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
+from conftest import SHIPPED_CONFIGS
 
 from designopt.config import ConfigError, dump_config, load_config, parse_config
 from designopt.problem import problem_from_config
 
-CONFIGS = sorted(p for p in Path(__file__).resolve().parent.parent.joinpath("configs").glob("*.yaml")
-                 if not p.name.startswith("."))  # not benchmarks/search_seeds.py's per-seed copies
+CONFIGS = SHIPPED_CONFIGS
 
 
 @pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.name)

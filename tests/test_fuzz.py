@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from conftest import SHIPPED_CONFIGS
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
@@ -19,7 +20,7 @@ from typer.testing import CliRunner
 from cli.main import app
 
 ROOT = Path(__file__).resolve().parent.parent
-CONFIGS = sorted(p for p in (ROOT / "configs").glob("*.yaml") if not p.name.startswith("."))  # not per-seed copies
+CONFIGS = SHIPPED_CONFIGS
 runner = CliRunner()
 
 # Values a user (or a typo) might put anywhere: wrong types, non-finite and extreme numbers, small integers
