@@ -198,7 +198,11 @@ def design_from(problem: DesignProblem, other: DesignProblem, q_d_other: np.ndar
     """``problem``'s design joints with the values another problem's design ``q_d_other`` gives the joints of the
     same name (e.g. a neighbouring structure's placement and link lengths); the others keep their configured
     values."""
-    given = {j.name: float(v) for j, v in zip(other.chain.design, q_d_other, strict=True)}
+    return design_named(problem, {j.name: float(v) for j, v in zip(other.chain.design, q_d_other, strict=True)})
+
+
+def design_named(problem: DesignProblem, given: dict[str, float]) -> np.ndarray:
+    """``problem``'s design joints: the value ``given`` names for each, else its configured value."""
     return np.array([given.get(j.name, j.value) for j in problem.chain.design])
 
 

@@ -265,6 +265,16 @@ MUTATIONS = [
     Mutation("nlpsol builds the reverse derivative of the whole NLP at set-up (most of a cell's build)",
              "designopt/solve/backends/ipopt.py", '"ipopt.acceptable_iter": 10, "no_nlp_grad": True}',
              '"ipopt.acceptable_iter": 10}', ("tests/test_transcriptions.py",)),
+    Mutation("a grown start's inserted link keeps its configured twist (not an identity transform)",
+             "designopt/solve/starts.py", 'given |= {f"link{where + 1}.{param}": 0.0 for param in DH_PARAMS}',
+             'given |= {f"link{where + 1}.{param}": 0.0 for param in DH_PARAMS[:3]}', ("tests/test_sweep.py",)),
+    Mutation("a grown start's links after the inserted one keep their numbers",
+             "designopt/solve/starts.py", 'return f"link{int(link) + (int(link) > where)}.{param}"',
+             'return f"link{int(link)}.{param}"', ("tests/test_sweep.py",)),
+    Mutation("a structure takes a start from every neighbour, cheaper or not",
+             "designopt/solve/strategies/neighbours.py",
+             "if theirs is None or (own is not None and theirs.metrics.design_cost >= own.metrics.design_cost):",
+             "if theirs is None:", ("tests/test_sweep.py",)),
 ]
 
 

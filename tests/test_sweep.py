@@ -20,7 +20,7 @@ from cli.main import app
 from designopt.config import load_config
 from designopt.experiments.sweep import enumerate_structures, run_sweep
 from designopt.solve import Search, SolverProfile
-from designopt.solve.strategies.neighbours import neighbours
+from designopt.solve.strategies.neighbours import neighbours, shorter
 from designopt.verify import verify_file
 
 runner = CliRunner()
@@ -41,6 +41,74 @@ def test_neighbours_differ_in_one_joint_type():
     assert sorted(neighbours("RRP", structures)) == ["PRP", "RPP", "RRR"]
     assert neighbours("R", structures) == ["P"]
     assert all(len(neighbours(s, structures)) == len(s) for s in structures)
+
+
+def test_shorter_neighbours_are_the_structure_without_one_joint():
+    structures = enumerate_structures(1, 4)
+    assert shorter("RRPR", structures) == [("RPR", 0), ("RPR", 1), ("RRR", 2), ("RRP", 3)]
+    assert shorter("R", structures) == [] and shorter("RRPR", ["RRPR", "PRR"]) == []
+    for s in structures:  # inserting the joint back gives the structure
+        assert all(other[:k] + s[k] + other[k:] == s for other, k in shorter(s, structures))
+
+
+@pytest.mark.parametrize("small, where, big", [("RRP", 0, "RRRP"), ("RRP", 1, "RPRP"), ("RRP", 3, "RRPR"),
+                                               ("PRR", 2, "PRPR"), ("RRRRR", 2, "RRRRRR")])
+def test_a_grown_start_keeps_the_shorter_structures_tool_path(small, where, big):
+    """The invariant behind `Grown`: a structure with a link inserted as an identity transform, its joint at 0,
+    puts the tool (and the workpiece) exactly where the shorter structure did, at every waypoint."""
+    from types import SimpleNamespace
+
+    from designopt.config import parse_config
+    from designopt.initial_guess import initial_guess
+    from designopt.kinematics.chain import placement_pose, tool_pose
+    from designopt.problem import problem_from_config
+    from designopt.solve.starts import grown_guess
+
+    def problem(structure):
+        return problem_from_config(parse_config({
+            "toolpath": {"kind": "line", "length": 0.2, "waypoints": 6}, "placement": {"xyz": [0.3, 0.0, -0.2]},
+            "robot": {"dh": "generic", "structure": structure}}))
+
+    source, target = problem(small), problem(big)
+    guess = initial_guess(source, 3, 7, 0.3)  # a perturbed design and some joint values (tracking or not)
+    rng = np.random.default_rng(0)
+    V = rng.normal(size=guess.Q.shape)
+    solution = SimpleNamespace(raw=SimpleNamespace(q_d=guess.q_d), sample=lambda t: guess.Q,
+                               sample_velocity=lambda t: V)
+    grown = grown_guess(target, source, solution, where, seed=5)
+    assert grown.Q.shape == (6, len(big)) and np.all(grown.Q[:, where] == 0) and np.all(grown.V[:, where] == 0)
+    assert np.array_equal(np.delete(grown.V, where, axis=1), V)
+    for q_small, q_big in zip(guess.Q, grown.Q, strict=True):
+        assert np.allclose(tool_pose(target.chain, q_big, grown.q_d), tool_pose(source.chain, q_small, guess.q_d),
+                           atol=1e-12)
+        assert np.allclose(placement_pose(target.chain, q_big, grown.q_d),
+                           placement_pose(source.chain, q_small, guess.q_d), atol=1e-12)
+    with pytest.raises(ValueError, match=f"not {small} with a joint inserted"):
+        grown_guess(problem("RR"), source, solution, 0)
+
+
+@pytest.mark.parametrize("shorter_cost, grown", [(1.0, [0, 1, 2]), (3.0, [])])
+def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_design(shorter_cost, grown):
+    from types import SimpleNamespace
+
+    from designopt.config import parse_config
+    from designopt.problem import problem_from_config
+    from designopt.solve import Job, Searched, preset
+    from designopt.solve.starts import Grown
+    from designopt.solve.strategies import neighbours as neighbour_stage
+
+    def searched(structure, cost):
+        job = Job("sweep", problem_from_config(parse_config({"robot": {"dh": "generic", "structure": structure}})))
+        sol = SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
+                              raw=SimpleNamespace(q_d=job.problem.chain.design_values))
+        return Searched(job, [], [(SimpleNamespace(), sol)])
+
+    plan = neighbour_stage.plan([searched("RRP", shorter_cost), searched("RRRP", 2.0)], preset("quick"))
+    tasks = next(plan, [])
+    # RRRP is RRP with a joint inserted at 0, 1 or 2 (and RRR, absent, at 3); RRP has no shorter neighbour here
+    assert [t.start.where for t in tasks] == grown
+    assert all(isinstance(t.start, Grown) and t.problem.chain.structure == "RRRP" and t.profile.warm for t in tasks)
+    assert len({t.start.number for t in tasks}) == len(tasks)
 
 
 def test_a_neighbours_design_starts_the_joints_of_the_same_name():
@@ -89,14 +157,15 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
     stages = summary.groupby(["structure", "stage"]).size()
     for s in ("RR", "RP", "PR", "PP"):  # every structure gets the same search: 3 coarse starts, the best 2 refined
         assert stages[s, "explore"] == 3 and stages.get((s, "refine"), 0) <= 2
-    # a structure gets a neighbour-seeded start exactly when a neighbour (one joint type changed) searched its
-    # way to a cheaper design than its own
+    # a structure gets a neighbour's start exactly when a neighbour (one joint type changed, or one joint fewer)
+    # searched its way to a cheaper design than its own, one start per such neighbour (and insertion)
     refined = summary[summary["stage"] == "refine"]
     best = refined[refined["tracks"]].groupby("structure")["design_cost"].min()
-    seeded = set(summary.loc[summary["stage"] == "neighbour", "structure"])
+    seeded = summary.loc[summary["stage"] == "neighbour", "structure"].value_counts()
     for s in best.index:
         better = [n for n in neighbours(s, list(best.index)) if best[n] < best[s]]
-        assert (s in seeded) == bool(better), s
+        better += [n for n, _ in shorter(s, list(best.index)) if best[n] < best[s]]
+        assert seeded.get(s, 0) == len(better), s
     assert "6 structures solved" in result.output
     table = pd.read_csv(run / "table.csv")
     assert list(table["structure"]) == ["R", "P", "RR", "RP", "PR", "PP"]

@@ -2,9 +2,10 @@
 
 Each structure gets its continuous design joints (R link: d, a, alpha; P link: theta, a, alpha) plus the six
 placement joints, and the config's search (`designopt.solve.search`), with the structure-neighbour starts: a
-structure whose neighbour (one joint type changed) found a better design gets a start from it. Each stage's solves
-of all structures are fanned out together with joblib (loky processes, or a dask.distributed cluster); each
-finished solve is written at once, so a killed sweep keeps what it finished and ``resume`` solves only the rest.
+structure whose neighbour (one joint type changed, or one joint fewer) found a better design gets a start from
+it. Each stage's solves of all structures are fanned out together with joblib (loky processes, or a
+dask.distributed cluster); each finished solve is written at once, so a killed sweep keeps what it finished and
+``resume`` solves only the rest.
 """
 
 from __future__ import annotations

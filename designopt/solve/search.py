@@ -34,8 +34,9 @@ class Search:
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
     design joint are one optimum. ``hold_degenerate``: a solve stalled on a degenerate design is finished with
     the design held there (`strategies.continuation`). ``structure_neighbours``: after the strategy, one more
-    start per problem from each neighbouring structure's better design (`strategies.neighbours`; only problems
-    whose structures differ in one joint type are neighbours). ``profile``: the full-path solves' solver profile.
+    start per problem from each neighbouring structure's better design (`strategies.neighbours`; problems whose
+    structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
+    solver profile.
     """
 
     strategy: str = "coarse_to_fine"

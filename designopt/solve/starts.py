@@ -1,8 +1,9 @@
-"""Where a solve starts: a seeded start (`Seeded`), a solution of another sampling of the same task (`Lifted`), or a
-coarse optimum's design on a new joint branch (`Rebranched`).
+"""Where a solve starts: a seeded start (`Seeded`), a solution of another sampling of the same task (`Lifted`), a
+coarse optimum's design on a new joint branch (`Rebranched`), or a solution of a structure with one joint fewer
+(`Grown`).
 
 Every start has a ``number`` that identifies it in a run's files (the seed column of summary.csv): seed * 1000 +
-index for a seeded or rebranched start, the lifted solution's number for a lifted one.
+index for a seeded, rebranched or grown start, the lifted solution's number for a lifted one.
 """
 
 from __future__ import annotations
@@ -11,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from designopt.initial_guess import initial_guess
+from designopt.initial_guess import design_named, initial_guess
+from designopt.kinematics.joints import DH_PARAMS
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
@@ -73,6 +75,50 @@ class Rebranched:
         # with a design given, spread "box" only sets the first joints' range: the whole circle
         return initial_guess(problem, self.index, self.seed, 0.0, self.init, np.asarray(self.solution.raw.q_d, float),
                              "box")
+
+
+@dataclass(frozen=True, eq=False)
+class Grown:
+    """A solution of a structure with one joint fewer (``source``, its problem) as a start of this structure, which
+    is that one with a link inserted at ``where`` (0-based): the link an identity transform (its DH parameters 0)
+    whose joint stays at 0 along the path, every other design joint and joint trajectory the solution's
+    (`grown_guess`). The start tracks the path exactly as the solution did; only the inserted joint's compliance
+    is new. ``seed`` and ``index`` number it."""
+
+    solution: object  # designopt.solution.Solution
+    source: DesignProblem
+    where: int
+    seed: int
+    index: int
+
+    @property
+    def number(self) -> int:
+        return self.seed * 1000 + self.index
+
+    def guess(self, problem: DesignProblem) -> InitialGuess:
+        return grown_guess(problem, self.source, self.solution, self.where, self.number)
+
+
+def grown_guess(problem: DesignProblem, source: DesignProblem, solution, where: int, seed: int = 0) -> InitialGuess:
+    """`Grown`'s start: ``problem``'s chain is ``source``'s with a DH link inserted at ``where`` (0-based, so link
+    ``where + 1`` is new and source link i > where becomes link i + 1); the design joints by (renamed) name, the
+    new link's parameters 0 (an identity transform at joint value 0), the joints and velocities of ``solution``
+    at ``problem``'s waypoint times with the new joint's column 0."""
+    if problem.chain.n_moving != source.chain.n_moving + 1 or not 0 <= where <= source.chain.n_moving:
+        raise ValueError(f"{problem.chain.structure} is not {source.chain.structure} with a joint inserted at {where}")
+
+    def renamed(name: str) -> str:
+        if not name.startswith("link"):
+            return name
+        link, param = name[4:].split(".", 1)
+        return f"link{int(link) + (int(link) > where)}.{param}"
+
+    given = {renamed(j.name): float(v) for j, v in zip(source.chain.design, solution.raw.q_d, strict=True)}
+    given |= {f"link{where + 1}.{param}": 0.0 for param in DH_PARAMS}
+    t = problem.toolpath.t
+    Q = np.insert(solution.sample(t), where, 0.0, axis=1)
+    V = np.insert(solution.sample_velocity(t), where, 0.0, axis=1)
+    return InitialGuess(q_d=design_named(problem, given), Q=Q, V=V, seed=seed)
 
 
 def lifted_guess(problem: DesignProblem, solution) -> InitialGuess:

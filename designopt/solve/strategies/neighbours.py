@@ -1,17 +1,20 @@
 """Neighbour starts: one more start per problem from each neighbouring structure that found a better design.
 
-Two problems of one search are neighbours when they share their case and their structures differ in one joint's
-type (R <-> P). A structure whose neighbour found a cheaper design was stuck in a worse basin, and the neighbour's
-design -- its placement and every link parameter of the same name -- is a good guess for it. The starts are solved
-on the full path (stage ``neighbour``) and join each problem's final solves. Problems without neighbours (every
-search of a single structure) get no task.
+Two problems of one search are neighbours when they share their case and their structures are one edit apart:
+one joint's type differs (R <-> P), or one has a joint the other lacks. A structure whose neighbour found a cheaper
+design was stuck in a worse basin, and the neighbour's design is a good guess for it: a structure of the same
+length starts from its placement and every link parameter of the same name (`Seeded` with that design, joints by
+IK); a structure with one joint fewer is this one with a link held as an identity transform, so its solution, the
+link inserted, is a start that already tracks the path (`Grown`, solved warm). The starts are solved on the full
+path (stage ``neighbour``) and join each problem's final solves. Problems without neighbours (every search of a
+single structure) get no task.
 """
 
 from __future__ import annotations
 
 from designopt.initial_guess import design_from
 from designopt.solve.search import Searched, by_job
-from designopt.solve.starts import Seeded
+from designopt.solve.starts import Grown, Seeded
 from designopt.solve.strategies.steps import solve_setup
 from designopt.solve.tasks import Task
 
@@ -24,21 +27,42 @@ def neighbours(structure: str, structures: list[str]) -> list[str]:
             if len(s) == len(structure) and sum(a != b for a, b in zip(s, structure, strict=True)) == 1]
 
 
+def shorter(structure: str, structures: list[str]) -> list[tuple[str, int]]:
+    """(other, where) for every structure among ``structures`` that is ``structure`` without its joint ``where``
+    (0-based): ``structure`` is ``other`` with a joint inserted at ``where``. One pair per position, so a structure
+    can be one shorter one in several ways (RRPR: RPR without joint 0 or 1)."""
+    present = set(structures)
+    return [(structure[:k] + structure[k + 1:], k) for k in range(len(structure))
+            if len(structure) > 1 and structure[:k] + structure[k + 1:] in present]
+
+
 def plan(searched, search):
     jobs = [s.job for s in searched]
     best = {(s.job.case, s.job.problem.chain.structure): (s.job, s.best[1]) for s in searched}
+
+    def cheaper(case: str, other: str, own) -> tuple | None:
+        """(job, best solution) of structure ``other`` when it found a cheaper design than ``own``."""
+        other_job, theirs = best[case, other]
+        if theirs is None or (own is not None and theirs.metrics.design_cost >= own.metrics.design_cost):
+            return None
+        return other_job, theirs
+
     tasks = []
     for s in searched:
-        job, own = s.job, s.best[1]
+        job, own, structure = s.job, s.best[1], s.job.problem.chain.structure
         same_case = [st for case, st in best if case == job.case]
-        for j, other in enumerate(neighbours(job.problem.chain.structure, same_case)):
-            other_job, theirs = best[job.case, other]
-            if theirs is None or (own is not None and theirs.metrics.design_cost >= own.metrics.design_cost):
-                continue
-            design = design_from(job.problem, other_job.problem, theirs.raw.q_d)
-            profile, continuation = solve_setup(job, search)
-            tasks.append(Task(job.case, STAGE, job.problem, job.transcription, profile,
-                              Seeded(search.seed, j, search.perturbation, search.init, design), continuation))
+        same_length = neighbours(structure, same_case)
+        for j, other in enumerate(same_length):
+            if found := cheaper(job.case, other, own):
+                design = design_from(job.problem, found[0].problem, found[1].raw.q_d)
+                profile, continuation = solve_setup(job, search)
+                tasks.append(Task(job.case, STAGE, job.problem, job.transcription, profile,
+                                  Seeded(search.seed, j, search.perturbation, search.init, design), continuation))
+        for k, (other, where) in enumerate(shorter(structure, same_case)):
+            if found := cheaper(job.case, other, own):
+                profile, continuation = solve_setup(job, search, search.profile.warmed())
+                start = Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)
+                tasks.append(Task(job.case, STAGE, job.problem, job.transcription, profile, start, continuation))
     if not tasks:
         return searched
     more = by_job(jobs, (yield tasks))
