@@ -83,8 +83,9 @@ def test_a_grown_start_keeps_the_shorter_structures_tool_path(small, where, big)
                            atol=1e-12)
         assert np.allclose(placement_pose(target.chain, q_big, grown.q_d),
                            placement_pose(source.chain, q_small, guess.q_d), atol=1e-12)
-    with pytest.raises(ValueError, match=f"not {small} with a joint inserted"):
-        grown_guess(problem("RR"), source, solution, 0)
+    for wrong, at in (("RR", 0), ("P" * (len(small) + 1), where), (big, len(big))):
+        with pytest.raises(ValueError, match=f"not {small} with a joint inserted"):
+            grown_guess(problem(wrong), source, solution, at)
 
 
 @pytest.mark.parametrize("shorter_cost, grown", [(1.0, [0, 1, 2]), (3.0, [])])

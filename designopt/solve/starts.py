@@ -103,8 +103,10 @@ def grown_guess(problem: DesignProblem, source: DesignProblem, solution, where: 
     """`Grown`'s start: ``problem``'s chain is ``source``'s with a DH link inserted at ``where`` (0-based, so link
     ``where + 1`` is new and source link i > where becomes link i + 1); the design joints by (renamed) name, the
     new link's parameters 0 (an identity transform at joint value 0), the joints and velocities of ``solution``
-    at ``problem``'s waypoint times with the new joint's column 0."""
-    if problem.chain.n_moving != source.chain.n_moving + 1 or not 0 <= where <= source.chain.n_moving:
+    at ``problem``'s waypoint times with the new joint's column 0. Parameters that are not design joints keep
+    ``problem``'s own values (in a sweep every DH parameter but the joint's is one)."""
+    grown, short = problem.chain.structure, source.chain.structure
+    if not 0 <= where < len(grown) or grown[:where] + grown[where + 1:] != short:
         raise ValueError(f"{problem.chain.structure} is not {source.chain.structure} with a joint inserted at {where}")
 
     def renamed(name: str) -> str:
