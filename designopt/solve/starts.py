@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from designopt.initial_guess import design_named, initial_guess
-from designopt.kinematics.joints import DH_PARAMS
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
@@ -101,22 +100,23 @@ class Grown:
 
 def grown_guess(problem: DesignProblem, source: DesignProblem, solution, where: int, seed: int = 0) -> InitialGuess:
     """`Grown`'s start: ``problem``'s chain is ``source``'s with a DH link inserted at ``where`` (0-based, so link
-    ``where + 1`` is new and source link i > where becomes link i + 1); the design joints by (renamed) name, the
+    ``where + 1`` is new and source link i > where becomes link i + 1; both chains DH tables); each design joint
+    of ``source`` carried to the joint of the same link (so shifted) and parameter, the placement's as they are, the
     new link's parameters 0 (an identity transform at joint value 0), the joints and velocities of ``solution``
     at ``problem``'s waypoint times with the new joint's column 0. Parameters that are not design joints keep
     ``problem``'s own values (in a sweep every DH parameter but the joint's is one)."""
     grown, short = problem.chain.structure, source.chain.structure
-    if not 0 <= where < len(grown) or grown[:where] + grown[where + 1:] != short:
+    dh_tables = problem.chain.dh is not None and source.chain.dh is not None
+    if not dh_tables or not 0 <= where < len(grown) or grown[:where] + grown[where + 1:] != short:
         raise ValueError(f"{problem.chain.structure} is not {source.chain.structure} with a joint inserted at {where}")
 
-    def renamed(name: str) -> str:
-        if not name.startswith("link"):
-            return name
-        link, param = name[4:].split(".", 1)
-        return f"link{int(link) + (int(link) > where)}.{param}"
-
-    given = {renamed(j.name): float(v) for j, v in zip(source.chain.design, solution.raw.q_d, strict=True)}
-    given |= {f"link{where + 1}.{param}": 0.0 for param in DH_PARAMS}
+    # source joint name -> this chain's joint of the same link (shifted past the inserted one) and parameter
+    named = {j.name: j.name for j in source.chain.placement_joints}
+    for i, link in enumerate(source.chain.dh):
+        moved = problem.chain.dh[i + (i >= where)]
+        named |= {source.chain.joints[a].name: problem.chain.joints[b].name for a, b in zip(link, moved, strict=True)}
+    given = {named[j.name]: float(v) for j, v in zip(source.chain.design, solution.raw.q_d, strict=True)}
+    given |= {problem.chain.joints[b].name: 0.0 for b in problem.chain.dh[where]}
     t = problem.toolpath.t
     Q = np.insert(solution.sample(t), where, 0.0, axis=1)
     V = np.insert(solution.sample_velocity(t), where, 0.0, axis=1)

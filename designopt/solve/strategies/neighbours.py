@@ -32,8 +32,7 @@ def shorter(structure: str, structures: list[str]) -> list[tuple[str, int]]:
     (0-based): ``structure`` is ``other`` with a joint inserted at ``where``. One pair per position, so a structure
     can be one shorter one in several ways (RRPR: RPR without joint 0 or 1)."""
     present = set(structures)
-    return [(structure[:k] + structure[k + 1:], k) for k in range(len(structure))
-            if len(structure) > 1 and structure[:k] + structure[k + 1:] in present]
+    return [(other, k) for k in range(len(structure)) if (other := structure[:k] + structure[k + 1:]) in present]
 
 
 def plan(searched, search):
@@ -51,18 +50,18 @@ def plan(searched, search):
     for s in searched:
         job, own, structure = s.job, s.best[1], s.job.problem.chain.structure
         same_case = [st for case, st in best if case == job.case]
-        same_length = neighbours(structure, same_case)
+        same_length, starts = neighbours(structure, same_case), []
         for j, other in enumerate(same_length):
             if found := cheaper(job.case, other, own):
                 design = design_from(job.problem, found[0].problem, found[1].raw.q_d)
-                profile, continuation = solve_setup(job, search)
-                tasks.append(Task(job.case, STAGE, job.problem, job.transcription, profile,
-                                  Seeded(search.seed, j, search.perturbation, search.init, design), continuation))
+                starts.append((solve_setup(job, search), Seeded(search.seed, j, search.perturbation, search.init,
+                                                                design)))
         for k, (other, where) in enumerate(shorter(structure, same_case)):
             if found := cheaper(job.case, other, own):
-                profile, continuation = solve_setup(job, search, search.profile.warmed())
-                start = Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)
-                tasks.append(Task(job.case, STAGE, job.problem, job.transcription, profile, start, continuation))
+                starts.append((solve_setup(job, search, search.profile.warmed()),
+                               Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)))
+        tasks += [Task(job.case, STAGE, job.problem, job.transcription, profile, start, continuation)
+                  for (profile, continuation), start in starts]
     if not tasks:
         return searched
     more = by_job(jobs, (yield tasks))
