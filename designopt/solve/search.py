@@ -77,10 +77,21 @@ class Search:
                 f"on the full path ({cap}){held}")
 
 
+# IPOPT options for design spaces whose tracking Jacobian goes rank-deficient on the way: a structure with fewer
+# than six joints tracks a path only on a degenerate design, and prismatic joints line up. There IPOPT's multipliers
+# blow up (dual infeasibility 1e5-1e12) and a solve creeps to its cap. These regularise the constraint block of
+# every KKT system (delta_c = 1e-8 mu^0.25, what IPOPT does anyway once it has found the Jacobian degenerate) and
+# step the multipliers to reduce the dual infeasibility. On the K = I sweep (seed 0): 1,473 instead of 2,113 of the
+# 5,040 exploration solves at the cap, 0.71x the solver CPU, 61 of 123 structure bests lower and 23 higher. On the
+# main job (six revolute joints, default search) they made the answer worse (docs/decisions.md, 2026-11-24).
+DEGENERATE_JACOBIAN = (("ipopt.perturb_always_cd", "yes"), ("ipopt.alpha_for_y", "min-dual-infeas"))
+
 PRESETS: dict[str, Search] = {
     # a structure sweep's per-structure search: half the default's starts and refinements, tighter caps, no second
-    # round on new joint branches (not yet measured on the sweep, whose exploration it would double)
-    "quick": Search(starts=40, rebranch=0, refine=2, profile=SolverProfile(max_iter=600, time_limit=60.0)),
+    # round on new joint branches (not yet measured on the sweep, whose exploration it would double), and IPOPT
+    # set for degenerate Jacobians (most of a sweep's structures have fewer than six joints or prismatic ones)
+    "quick": Search(starts=40, rebranch=0, refine=2,
+                    profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     "default": Search(),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     # the paper's comparisons: every method gets the same seeded cold starts on the full path, start for start
