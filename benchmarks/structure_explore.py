@@ -22,12 +22,10 @@ from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
-import yaml
 
-from designopt.config import parse_config
+from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
-from designopt.problem import problem_from_config
-from designopt.solve import Job
+from designopt.experiments.sweep import sweep_jobs
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
 from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import fan_out
@@ -46,16 +44,14 @@ def _value(text: str):
 
 
 def explore(config: Path, structures: list[str], seed: int, options: list[str], jobs: int) -> list[dict]:
-    raw = yaml.safe_load(config.read_text())
-    search = replace(search_from_config(parse_config(raw)), seed=seed)
+    cfg = load_config(config)
+    search = replace(search_from_config(cfg), seed=seed)
     given = tuple((k, _value(v)) for k, v in (o.split("=", 1) for o in options if o != "none"))
     own = () if "none" in options else search.profile.options
     search = replace(search, profile=replace(search.profile, options=(*own, *given)))
     tasks = []
-    for structure in structures:
-        problem = problem_from_config(parse_config({**raw, "robot": {**raw.get("robot", {}), "structure": structure}}))
-        job = Job("sweep", problem)
-        tasks += seeded_tasks(job, "explore", coarse_problem(problem, search.explore_waypoints),
+    for job in sweep_jobs(cfg, structures):
+        tasks += seeded_tasks(job, "explore", coarse_problem(job.problem, search.explore_waypoints),
                               search.profile.capped(search.explore_max_iter), search, search.starts)
     return [{"structure": t.problem.chain.structure, "start": t.seed, "status": s.raw.status,
              "iterations": s.raw.iterations, "cpu_s": s.raw.solve_time_s, "tracks": bool(s.metrics.tracks),
@@ -94,8 +90,8 @@ def main() -> None:
     rows = explore(args.config, args.structures, args.seed, args.option, args.jobs)
     if args.json:
         args.json.write_text(json.dumps(rows))
-    compare_rows = pd.DataFrame(rows)
-    print(f"{len(rows)} solves, {compare_rows.cpu_s.sum():.1f} s, {(compare_rows.status == CAPPED).sum()} at the cap")
+    solved = pd.DataFrame(rows)
+    print(f"{len(rows)} solves, {solved.cpu_s.sum():.1f} s, {(solved.status == CAPPED).sum()} at the cap")
 
 
 if __name__ == "__main__":
