@@ -90,77 +90,26 @@ def test_a_grown_start_keeps_the_shorter_structures_tool_path(small, where, big)
 
 @pytest.mark.parametrize("shorter_cost, grown", [(1.0, [0, 1, 2]), (3.0, [])])
 def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_design(shorter_cost, grown):
-    from designopt.solve import preset
+    from types import SimpleNamespace
+
+    from designopt.config import parse_config
+    from designopt.problem import problem_from_config
+    from designopt.solve import Job, Searched, preset
     from designopt.solve.starts import Grown
     from designopt.solve.strategies import neighbours as neighbour_stage
 
-    plan = neighbour_stage.plan([_searched("RRP", shorter_cost), _searched("RRRP", 2.0)], preset("quick"))
+    def searched(structure, cost):
+        job = Job("sweep", problem_from_config(parse_config({"robot": {"dh": "generic", "structure": structure}})))
+        sol = SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
+                              raw=SimpleNamespace(q_d=job.problem.chain.design_values))
+        return Searched(job, [], [(SimpleNamespace(), sol)])
+
+    plan = neighbour_stage.plan([searched("RRP", shorter_cost), searched("RRRP", 2.0)], preset("quick"))
     tasks = next(plan, [])
     # RRRP is RRP with a joint inserted at 0, 1 or 2 (and RRR, absent, at 3); RRP has no shorter neighbour here
     assert [t.start.where for t in tasks] == grown
     assert all(isinstance(t.start, Grown) and t.problem.chain.structure == "RRRP" and t.profile.warm for t in tasks)
     assert len({t.start.number for t in tasks}) == len(tasks)
-
-
-def _searched(structure, cost):
-    """A searched structure whose one full-path solve found a design of ``cost`` (its configured design)."""
-    from types import SimpleNamespace
-
-    from designopt.config import parse_config
-    from designopt.problem import problem_from_config
-    from designopt.solve import Job, Searched
-
-    job = Job("sweep", problem_from_config(parse_config({"robot": {"dh": "generic", "structure": structure}})))
-    return Searched(job, [], [(SimpleNamespace(seed=-1), _solution(cost, job.problem.chain.design_values))])
-
-
-def _solution(cost, q_d):
-    from types import SimpleNamespace
-
-    return SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost), raw=SimpleNamespace(q_d=q_d))
-
-
-@pytest.mark.parametrize("rrrp_after, rounds, second", [
-    (0.5, 2, [("RRRR", "RRRP", 16)]),  # RRRP improved to below RRRR: RRRR starts again from RRRP's new design
-    (2.5, 2, []),  # RRRP did not improve: RRRR, though improved, is not cheaper than RRRP; nothing new to pass on
-    (0.5, 1, None),  # one round: no second
-])
-def test_a_later_neighbour_round_starts_only_from_structures_the_round_before_improved(rrrp_after, rounds, second):
-    from dataclasses import replace
-
-    from designopt.initial_guess import design_from
-    from designopt.solve import preset
-    from designopt.solve.starts import Grown, Seeded
-    from designopt.solve.strategies import neighbours as neighbour_stage
-
-    searched = [_searched("RRP", 1.0), _searched("RRRP", 2.0), _searched("RRRR", 3.0)]
-    plan = neighbour_stage.plan(searched, replace(preset("quick"), neighbour_rounds=rounds))
-    first = next(plan)
-    # round 1: RRRP grows from RRP (inserted at 0, 1, 2); RRRR starts from RRRP's design (RRR, absent, is not shorter)
-    assert sorted((t.problem.chain.structure, type(t.start).__name__) for t in first) == [
-        ("RRRP", "Grown"), ("RRRP", "Grown"), ("RRRP", "Grown"), ("RRRR", "Seeded")]
-    assert {t.stage for t in first} == {"neighbour"} and sorted(t.seed for t in first) == [0, 1, 2, 3]
-    rrrp = searched[1].job.problem
-    new_q = rrrp.chain.design_values + 0.1  # RRRP's improved design
-    done = [(t, _solution(rrrp_after if t.problem.chain.structure == "RRRP" else 2.9, new_q)) for t in first]
-    try:
-        tasks = plan.send(done)
-    except StopIteration as stop:
-        tasks, result = None, stop.value
-    if second is None:
-        assert tasks is None and [len(s.final) for s in result] == [1, 4, 2]
-        return
-    if not second:
-        assert tasks is None
-        return
-    assert [(t.problem.chain.structure, t.seed) for t in tasks] == [(s, n) for s, _, n in second]
-    assert {t.stage for t in tasks} == {"neighbour-2"}
-    assert all(isinstance(t.start, Seeded) and not isinstance(t.start, Grown) for t in tasks)
-    rrrr = searched[2].job.problem
-    np.testing.assert_array_equal(tasks[0].start.design, design_from(rrrr, rrrp, new_q))
-    with pytest.raises(StopIteration) as stop:  # the second round was the last
-        plan.send([(tasks[0], _solution(2.0, rrrr.chain.design_values))])
-    assert [min(s.metrics.design_cost for _, s in x.final) for x in stop.value.value] == [1.0, rrrp_after, 2.0]
 
 
 def test_a_neighbours_design_starts_the_joints_of_the_same_name():

@@ -33,10 +33,9 @@ class Search:
     skipped when the path has no more waypoints), and the
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
     design joint are one optimum. ``hold_degenerate``: a solve stalled on a degenerate design is finished with
-    the design held there (`strategies.continuation`). ``neighbour_rounds``: after the strategy, one more
+    the design held there (`strategies.continuation`). ``structure_neighbours``: after the strategy, one more
     start per problem from each neighbouring structure's better design (`strategies.neighbours`; problems whose
-    structures differ in one joint's type, or by one joint, are neighbours), and in each further round from the
-    neighbours the round before improved (0: none). ``profile``: the full-path solves'
+    structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
     solver profile.
     """
 
@@ -55,7 +54,7 @@ class Search:
     refine: int = 4
     distinct: float = 0.02
     hold_degenerate: bool = True
-    neighbour_rounds: int = 1
+    structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
 
     @property

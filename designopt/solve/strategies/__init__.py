@@ -29,7 +29,7 @@ def run_search(jobs: list[Job], search: Search, execute: Execute) -> list[Search
     if len({job.identity for job in jobs}) < len(jobs):
         raise ValueError("two jobs of one search share case, method and structure")
     searched = _drive(STRATEGIES[search.strategy].plan(jobs, search), execute)
-    if search.neighbour_rounds:
+    if search.structure_neighbours:
         searched = _drive(neighbours.plan(searched, search), execute)
     return searched
 

@@ -6,9 +6,8 @@ design was stuck in a worse basin, and the neighbour's design is a good guess fo
 length starts from its placement and every link parameter of the same name (`Seeded` with that design, joints by
 IK); a structure with one joint fewer is this one with a link held as an identity transform, so its solution, the
 link inserted, is a start that already tracks the path (`Grown`, solved warm). The starts are solved on the full
-path (stage ``neighbour``) and join each problem's final solves. A structure that a neighbour start improved is, in
-the next round (``neighbour-2``, ...), a source for its own neighbours, so a good design can travel several edits
-(``Search.neighbour_rounds``). Problems without neighbours (every search of a single structure) get no task.
+path (stage ``neighbour``) and join each problem's final solves. Problems without neighbours (every search of a
+single structure) get no task.
 """
 
 from __future__ import annotations
@@ -20,8 +19,6 @@ from designopt.solve.strategies.steps import solve_setup
 from designopt.solve.tasks import Task
 
 STAGE = "neighbour"
-# Start indices per round: a structure has at most 6 same-length neighbours and 6 shorter ones.
-ROUND_SLOTS = 16
 
 
 def neighbours(structure: str, structures: list[str]) -> list[str]:
@@ -38,23 +35,13 @@ def shorter(structure: str, structures: list[str]) -> list[tuple[str, int]]:
     return [(other, k) for k in range(len(structure)) if (other := structure[:k] + structure[k + 1:]) in present]
 
 
-def stage(round_: int) -> str:
-    """The stage name of neighbour round ``round_`` (1-based): ``neighbour``, ``neighbour-2``, ..."""
-    return STAGE if round_ == 1 else f"{STAGE}-{round_}"
-
-
-def round_tasks(searched, search, round_: int, sources: set | None) -> list[Task]:
-    """One round's neighbour starts: for every problem, one start from each neighbouring structure that found a
-    cheaper design than its own -- among ``sources`` ((case, structure) pairs) only, or every structure when
-    None. Start indices of round r begin at (r - 1) * ``ROUND_SLOTS``, so rounds never share a start number."""
+def plan(searched, search):
+    jobs = [s.job for s in searched]
     best = {(s.job.case, s.job.problem.chain.structure): (s.job, s.best[1]) for s in searched}
-    first = (round_ - 1) * ROUND_SLOTS
 
     def cheaper(case: str, other: str, own) -> tuple | None:
         """(job, best solution) of structure ``other`` when it found a cheaper design than ``own``."""
         other_job, theirs = best[case, other]
-        if sources is not None and (case, other) not in sources:
-            return None
         if theirs is None or (own is not None and theirs.metrics.design_cost >= own.metrics.design_cost):
             return None
         return other_job, theirs
@@ -67,36 +54,15 @@ def round_tasks(searched, search, round_: int, sources: set | None) -> list[Task
         for j, other in enumerate(same_length):
             if found := cheaper(job.case, other, own):
                 design = design_from(job.problem, found[0].problem, found[1].raw.q_d)
-                starts.append((solve_setup(job, search), Seeded(search.seed, first + j, search.perturbation,
-                                                                search.init, design)))
+                starts.append((solve_setup(job, search), Seeded(search.seed, j, search.perturbation, search.init,
+                                                                design)))
         for k, (other, where) in enumerate(shorter(structure, same_case)):
             if found := cheaper(job.case, other, own):
                 starts.append((solve_setup(job, search, search.profile.warmed()),
-                               Grown(found[1], found[0].problem, where, search.seed, first + len(same_length) + k)))
-        tasks += [Task(job.case, stage(round_), job.problem, job.transcription, profile, start, continuation)
+                               Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)))
+        tasks += [Task(job.case, STAGE, job.problem, job.transcription, profile, start, continuation)
                   for (profile, continuation), start in starts]
-    return tasks
-
-
-def improved(before, after) -> set:
-    """(case, structure) of every problem whose best design got cheaper from ``before`` to ``after``."""
-    def cost(s):
-        best = s.best[1]
-        return best.metrics.design_cost if best is not None else float("inf")
-
-    return {(a.job.case, a.job.problem.chain.structure) for b, a in zip(before, after, strict=True)
-            if cost(a) < cost(b)}
-
-
-def plan(searched, search):
-    """Rounds of neighbour starts (``search.neighbour_rounds``): the first from every structure's best; each later
-    one only from the structures the round before improved, so a better design travels on to their neighbours."""
-    jobs, sources = [s.job for s in searched], None
-    for round_ in range(1, search.neighbour_rounds + 1):
-        tasks = round_tasks(searched, search, round_, sources)
-        if not tasks:
-            break
-        more = by_job(jobs, (yield tasks))
-        after = [Searched(s.job, s.explore, s.final + m) for s, m in zip(searched, more, strict=True)]
-        sources, searched = improved(searched, after), after
-    return searched
+    if not tasks:
+        return searched
+    more = by_job(jobs, (yield tasks))
+    return [Searched(s.job, s.explore, s.final + m) for s, m in zip(searched, more, strict=True)]
