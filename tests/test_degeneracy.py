@@ -17,7 +17,7 @@ from designopt.evaluation import evaluate
 from designopt.kinematics.chain import tool_pose
 from designopt.problem import problem_from_config
 from designopt.solve import Search
-from designopt.solve.observers import DegenerateWatch
+from designopt.solve.observers import DegenerateWatch, Iterate
 from designopt.transcriptions.degeneracy import held_at_multiples_of_pi, q_independent_rows
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -89,7 +89,7 @@ def test_the_watch_stops_only_a_solve_that_stays_on_a_degenerate_design():
     watch = DegenerateWatch(problem, patience=3)
 
     def step(q_d):
-        return int(watch.observe(q_d))
+        return int(watch.observe(Iterate(q_d)))
 
     planar, puma = planar_design(problem), np.array([j.value for j in problem.chain.design])
     assert [step(planar), step(planar), step(puma), step(planar), step(planar)] == [0, 0, 0, 0, 0]

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from designopt.config import parse_config
 from designopt.experiments.adapters import search_from_config
-from designopt.initial_guess import residual_function
+from designopt.initial_guess import initial_guess, residual_function
 from designopt.problem import problem_from_config
 from designopt.solution import solve_and_evaluate
 from designopt.solve import (
@@ -32,6 +32,7 @@ from designopt.solve import (
     preset,
     run_search,
     run_task,
+    solve_guess,
 )
 from designopt.solve.starts import Rebranched
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
@@ -262,3 +263,36 @@ def test_a_problems_starts_go_to_few_workers(starts, workers):
         most = max(1, len(tasks) // (4 * workers))
         assert all(len(u) <= most for u in dispatched)
         assert len(dispatched) == sum(-(-n // most) for n in starts)
+
+
+def test_a_bound_stops_a_feasible_solve_still_above_it_and_nothing_else():
+    from designopt.solve.observers import AboveBound, Iterate
+
+    watch = AboveBound(None)
+    q_d = np.zeros(3)
+    for bound, iterate, expected in [
+        (None, Iterate(q_d, 9.0, 0.0), False),  # no bound: never
+        (1.0, Iterate(q_d, 1.5, 0.0), True),  # feasible and above it
+        (1.0, Iterate(q_d, 0.5, 0.0), False),  # below it: on its way to beat it
+        (1.0, Iterate(q_d, 9.0, 0.1), False),  # not yet feasible: its objective says nothing
+    ]:
+        watch.reset(bound)
+        steps = [watch.observe(iterate, 5) for _ in range(AboveBound.after // 5)]
+        assert steps[:-1] == [False] * (len(steps) - 1)  # never before `after` iterations
+        assert steps[-1] is expected and watch.stopped is expected
+
+
+def test_a_solve_given_a_bound_stops_at_it_with_its_status(milling_12, monkeypatch):
+    from designopt.solve.observers import AboveBound
+
+    monkeypatch.setattr(AboveBound, "after", 20)
+    problem = coarse_problem(problem_from_config(parse_config(milling_12)), 6)
+    profile = SolverProfile(max_iter=500, observers=("above_bound",))
+    guess = initial_guess(problem, 1, 0, 0.3)
+    free = solve_guess(problem, Collocation(), profile, guess)
+    assert free.raw.status == "Solve_Succeeded" and free.raw.iterations > 30
+    held = solve_guess(problem, Collocation(), profile, guess, bound=0.5 * free.raw.objective)
+    assert held.raw.status == "Stopped_Above_Bound" and 20 <= held.raw.iterations < free.raw.iterations
+    assert held.raw.objective > 0.5 * free.raw.objective
+    again = solve_guess(problem, Collocation(), profile, guess, bound=100.0 * free.raw.objective)
+    assert again.raw.status == "Solve_Succeeded" and again.raw.iterations == free.raw.iterations

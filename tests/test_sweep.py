@@ -101,7 +101,7 @@ def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_des
     def searched(structure, cost):
         job = Job("sweep", problem_from_config(parse_config({"robot": {"dh": "generic", "structure": structure}})))
         sol = SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
-                              raw=SimpleNamespace(q_d=job.problem.chain.design_values))
+                              raw=SimpleNamespace(q_d=job.problem.chain.design_values, objective=1.5 * cost))
         return Searched(job, [], [(SimpleNamespace(), sol)])
 
     plan = neighbour_stage.plan([searched("RRP", shorter_cost), searched("RRRP", 2.0)], preset("quick"))
@@ -110,6 +110,8 @@ def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_des
     assert [t.start.where for t in tasks] == grown
     assert all(isinstance(t.start, Grown) and t.problem.chain.structure == "RRRP" and t.profile.warm for t in tasks)
     assert len({t.start.number for t in tasks}) == len(tasks)
+    # each is held to its structure's best: stopped if still above 3x its objective (1.5 * 2.0) after 300 iterations
+    assert all(t.bound == pytest.approx(3 * 1.5 * 2.0) and "above_bound" in t.profile.observers for t in tasks)
 
 
 def test_a_neighbours_design_starts_the_joints_of_the_same_name():

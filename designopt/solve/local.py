@@ -46,10 +46,12 @@ def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
     return built, solver, (time.perf_counter() - t0) if _prepared.cache_info().misses > misses else 0.0
 
 
-def solve_guess(problem: DesignProblem, transcription, profile: SolverProfile, guess: InitialGuess) -> Solution:
-    """Solve the problem from ``guess``. A solve that fails is a solution with its status, not an exception."""
+def solve_guess(problem: DesignProblem, transcription, profile: SolverProfile, guess: InitialGuess,
+                bound: float | None = None) -> Solution:
+    """Solve the problem from ``guess`` (held to the objective ``bound`` if the profile observes "above_bound").
+    A solve that fails is a solution with its status, not an exception."""
     built, solver, spent = prepared(problem, transcription, profile)
-    outcome = solver.solve(built.pack(guess))
+    outcome = solver.solve(built.pack(guess), bound)
     q_d, trajectory, drift = built.unpack(outcome.x)
     raw = RawResult(q_d=q_d, trajectory=trajectory, status=outcome.status, success=outcome.success,
                     iterations=outcome.iterations, solve_time_s=outcome.solve_time_s, build_time_s=spent,

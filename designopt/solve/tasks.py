@@ -25,6 +25,7 @@ class Task:
     profile: SolverProfile
     start: object  # designopt.solve.starts.Seeded | Lifted | Rebranched
     continuation: object | None = None  # e.g. designopt.solve.strategies.continuation.HoldDegenerate
+    bound: float | None = None  # an objective the solve is held to, if its profile observes "above_bound"
 
     @property
     def method(self) -> str:
@@ -47,7 +48,7 @@ class Task:
 
 def run_task(task: Task) -> Solution:
     """Solve one task (and its continuation, when the solve stopped where the continuation takes over)."""
-    solution = solve_guess(task.problem, task.transcription, task.profile, task.start.guess(task.problem))
+    solution = solve_guess(task.problem, task.transcription, task.profile, task.start.guess(task.problem), task.bound)
     if task.continuation is not None:
         solution = task.continuation.finish(task, solution)
     return solution

@@ -27,7 +27,7 @@ class Prepared(Protocol):
 
     prepare_time_s: float
 
-    def solve(self, x0: np.ndarray) -> Outcome: ...
+    def solve(self, x0: np.ndarray, bound: float | None = None) -> Outcome: ...
 
 
 class Backend(Protocol):

@@ -19,7 +19,7 @@ import casadi as ca
 import numpy as np
 
 from designopt.solve.backends.base import Outcome
-from designopt.solve.observers import make_observers
+from designopt.solve.observers import Iterate, make_observers
 from designopt.transcriptions.nlp import NLP
 
 # no_nlp_grad: nlpsol otherwise builds, at set-up, the reverse derivative of the whole NLP ("nlp_grad"), which it
@@ -62,9 +62,10 @@ class Ipopt:
 class _Observe(ca.Callback):
     """IPOPT's iteration callback: hands the design joints x[:n_design] to every observer; stops when one says so."""
 
-    def __init__(self, observers, n_x: int, n_g: int, n_design: int):
+    def __init__(self, observers, n_x: int, n_g: int, n_design: int, lbg: np.ndarray, ubg: np.ndarray):
         ca.Callback.__init__(self)
         self.observers, self.n_x, self.n_g, self.n_design = observers, n_x, n_g, n_design
+        self.lbg, self.ubg = lbg, ubg
         self.construct("observe", {})
 
     def get_n_in(self):
@@ -84,8 +85,10 @@ class _Observe(ca.Callback):
         return ca.Sparsity.dense(n, 1)
 
     def eval(self, arg):
-        q_d = np.asarray(arg[0]).ravel()[: self.n_design]
-        stop = [o.observe(q_d, OBSERVE_EVERY) for o in self.observers]
+        g = np.asarray(arg[2]).ravel()
+        violation = float(np.max(np.maximum(self.lbg - g, g - self.ubg), initial=0.0))
+        iterate = Iterate(np.asarray(arg[0]).ravel()[: self.n_design], float(arg[1]), violation)
+        stop = [o.observe(iterate, OBSERVE_EVERY) for o in self.observers]
         return [1 if any(stop) else 0]
 
 
@@ -101,7 +104,8 @@ class PreparedIpopt:
         self.observers = make_observers(profile.observers, nlp.problem)
         self._callback = None  # CasADi keeps no Python reference: the callback must live as long as the solver
         if self.observers:
-            self._callback = _Observe(self.observers, nlp.n_variables, nlp.n_constraints, nlp.n_design)
+            self._callback = _Observe(self.observers, nlp.n_variables, nlp.n_constraints, nlp.n_design,
+                                      np.asarray(nlp.lbg, float), np.asarray(nlp.ubg, float))
             opts["iteration_callback"] = self._callback
             opts["iteration_callback_step"] = OBSERVE_EVERY
         self.solver = ca.nlpsol(nlp.name, "ipopt", problem, opts)
@@ -111,12 +115,13 @@ class PreparedIpopt:
         self._casadi_warns = nlp.n_equalities + int(np.sum(nlp.lbx == nlp.ubx)) > nlp.n_variables
         self.prepare_time_s = time.perf_counter() - t0
 
-    def solve(self, x0: np.ndarray) -> Outcome:
-        """Solve from x0 (clipped into the bounds). A solve that fails is an outcome with its status."""
+    def solve(self, x0: np.ndarray, bound: float | None = None) -> Outcome:
+        """Solve from x0 (clipped into the bounds); ``bound``: an objective the observers may hold the solve to
+        (`designopt.solve.observers.AboveBound`). A solve that fails is an outcome with its status."""
         nlp = self.nlp
         x0 = np.clip(np.asarray(x0, float), nlp.lbx, nlp.ubx)
         for o in self.observers:
-            o.reset()
+            o.reset(bound)
         if nlp.n_equalities > nlp.n_variables:
             # IPOPT would stop here before its first iteration, but only after CasADi printed a warning on the
             # terminal, once per solve (a sweep's one-joint structures: hundreds of lines).

@@ -6,8 +6,9 @@ design was stuck in a worse basin, and the neighbour's design is a good guess fo
 length starts from its placement and every link parameter of the same name (`Seeded` with that design, joints by
 IK); a structure with one joint fewer is this one with a link held as an identity transform, so its solution, the
 link inserted, is a start that already tracks the path (`Grown`, solved warm). The starts are solved on the full
-path (stage ``neighbour``) and join each problem's final solves. Problems without neighbours (every search of a
-single structure) get no task.
+path (stage ``neighbour``) and join each problem's final solves; one that is still above ``BOUND_FACTOR`` times its
+structure's best objective after 300 iterations is stopped there (`designopt.solve.observers.AboveBound`). Problems
+without neighbours (every search of a single structure) get no task.
 """
 
 from __future__ import annotations
@@ -19,6 +20,9 @@ from designopt.solve.strategies.steps import solve_setup
 from designopt.solve.tasks import Task
 
 STAGE = "neighbour"
+# A neighbour start still above this many times its structure's best objective after
+# `designopt.solve.observers.AboveBound.after` iterations is stopped there: it is not going to beat it.
+BOUND_FACTOR = 3.0
 
 
 def neighbours(structure: str, structures: list[str]) -> list[str]:
@@ -60,8 +64,9 @@ def plan(searched, search):
             if found := cheaper(job.case, other, own):
                 starts.append((solve_setup(job, search, search.profile.warmed()),
                                Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)))
-        tasks += [Task(job.case, STAGE, job.problem, job.transcription, profile, start, continuation)
-                  for (profile, continuation), start in starts]
+        bound = BOUND_FACTOR * own.raw.objective if own is not None else None
+        tasks += [Task(job.case, STAGE, job.problem, job.transcription, profile.observing("above_bound"), start,
+                       continuation, bound) for (profile, continuation), start in starts]
     if not tasks:
         return searched
     more = by_job(jobs, (yield tasks))
