@@ -275,6 +275,18 @@ MUTATIONS = [
              "designopt/solve/strategies/neighbours.py",
              "if theirs is None or (own is not None and theirs.metrics.design_cost >= own.metrics.design_cost):",
              "if theirs is None:", ("tests/test_sweep.py",)),
+    Mutation("a neighbour start is not held to its structure's best",
+             "designopt/solve/strategies/neighbours.py",
+             "bound = BOUND_FACTOR * own.raw.objective if own is not None else None", "bound = None",
+             ("tests/test_sweep.py",)),
+    Mutation("a bound stops a solve before its iterations are up",
+             "designopt/solve/observers.py", "self.bound is not None and self.iterations >= self.after",
+             "self.bound is not None", ("tests/test_search.py",)),
+    Mutation("a bound stops a solve at an infeasible iterate",
+             "designopt/solve/observers.py", "and iterate.violation <= self.tol and iterate.objective > self.bound",
+             "and iterate.objective > self.bound", ("tests/test_search.py",)),
+    Mutation("the backend does not hand a solve's bound to its observers",
+             "designopt/solve/backends/ipopt.py", "o.reset(bound)", "o.reset()", ("tests/test_search.py",)),
 ]
 
 
