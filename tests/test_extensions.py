@@ -34,7 +34,7 @@ class Sqp:
                 "qpsol_options": {"printLevel": "none", "error_on_fail": False}, "error_on_fail": False}
         solver = ca.nlpsol("sqp", "sqpmethod", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
 
-        def solve(x0):
+        def solve(x0, bound=None):  # no observers here, so nothing to hold a solve to its bound
             t = time.perf_counter()
             sol = solver(x0=np.clip(x0, nlp.lbx, nlp.ubx), lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
             stats = solver.stats()
