@@ -60,7 +60,8 @@ class Ipopt:
 
 
 class _Observe(ca.Callback):
-    """IPOPT's iteration callback: hands the design joints x[:n_design] to every observer; stops when one says so."""
+    """IPOPT's iteration callback: hands every observer the iterate (design joints x[:n_design], objective, largest
+    constraint violation); stops when one says so."""
 
     def __init__(self, observers, n_x: int, n_g: int, n_design: int, lbg: np.ndarray, ubg: np.ndarray):
         ca.Callback.__init__(self)
