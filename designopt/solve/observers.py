@@ -68,8 +68,8 @@ class AboveBound:
     to beat a known design that is still far above it by then rarely gets there: of the K = I sweep's neighbour
     starts past 300 iterations (seeds 0 and 1, 365 solves), none that went on to beat its structure's best was then
     above 1.73x it, and 241 of the 279 others were above 3x; on an untouched seed 4 of the 119 it stopped would have
-    beaten it, though other starts reached those bests
-    (docs/decisions.md). A solve without a bound is never stopped."""
+    beaten it, where other starts reached or beat those bests (docs/decisions.md). A solve without a bound is never
+    stopped."""
 
     status = "Stopped_Above_Bound"
     after = 300
