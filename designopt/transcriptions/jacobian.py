@@ -82,15 +82,16 @@ def block_gradient_function(terms: ca.Function, compile_mode: str) -> ca.Functio
     return compiled(ca.Function("block_gradient", [y, *params], [ca.densify(grad)]), compile_mode)
 
 
-def assemble_gradient(x, quadratic, f_of: ca.Function,
+def assemble_gradient(x, quadratic_gradient, f_of: ca.Function,
                       groups: list[tuple[ca.Function | None, np.ndarray, list]]) -> ca.Function:
     """grad_f(x, p) -> (f, df/dx), for nlpsol's ``grad_f`` option, of f(x) = sum over the blocks' points of
     phi_k(y_k) + ``quadratic``(x).
 
-    ``x``: the NLP's SX decision vector; ``quadratic``: the quadratic terms as an SX expression of it (or a
-    number); ``f_of``: x -> f. Each group is (block, y_index, block_inputs) with ``block`` from
-    `block_gradient_function` (None: no objective term), ``y_index`` (N x n_y) the position in x of each block
-    variable and ``block_inputs`` the block's constant extra inputs (mapped). Contributions to one entry add up.
+    ``x``: the NLP's SX decision vector; ``quadratic_gradient``: the gradient of the quadratic terms as an SX
+    column of it (None: there are none; `designopt.transcriptions.nlp.quadratic_derivatives`); ``f_of``: x -> f.
+    Each group is (block, y_index, block_inputs) with ``block`` from `block_gradient_function` (None: no objective
+    term), ``y_index`` (N x n_y) the position in x of each block variable and ``block_inputs`` the block's constant
+    extra inputs (mapped). Contributions to one entry add up.
     """
     n_x = x.shape[0]
     X = ca.MX.sym("x", n_x)
@@ -104,6 +105,6 @@ def assemble_gradient(x, quadratic, f_of: ca.Function,
     # one 1 per column: block entry e adds to entry rows[e] of the gradient
     scatter = ca.DM(ccs_sparsity(n_x, len(rows), rows, np.arange(len(rows))), 1.0)
     grad = ca.mtimes(scatter, ca.vertcat(*values)) if len(rows) else ca.MX(n_x, 1)
-    if not isinstance(quadratic, int | float):
-        grad += ca.Function("grad_quadratic", [x], [ca.densify(ca.gradient(quadratic, x))])(X)
+    if quadratic_gradient is not None:
+        grad += ca.Function("grad_quadratic", [x], [ca.densify(quadratic_gradient)])(X)
     return ca.Function("grad_f", [X, P], [f_of(X), grad], ["x", "p"], ["f", "grad_f_x"])
