@@ -60,19 +60,21 @@ def setup(config: str, waypoints: int, stage: str, options: tuple = (), compile_
     return problem, search
 
 
-def build_seconds(name: str, cache: str, compile_mode: str | None) -> float:
-    """Wall seconds a new process spends building and preparing problem ``name`` with compile cache ``cache``."""
+def build_seconds(name: str, cache: str, compile_mode: str | None) -> tuple[float, float]:
+    """(wall, CPU) seconds a new process spends building and preparing problem ``name`` with compile cache
+    ``cache``."""
     env = {**os.environ, "DESIGNOPT_CACHE": cache}
     mode = ["--compile", compile_mode] if compile_mode else []
     out = subprocess.run([sys.executable, __file__, "--build-only", name, *mode], env=env, check=True,
                          capture_output=True, text=True).stdout
-    return float(out.strip().splitlines()[-1])
+    wall, cpu = out.strip().splitlines()[-1].split()
+    return float(wall), float(cpu)
 
 
 def measure(name: str, starts: int, options: tuple = (), compile_mode: str | None = None) -> dict:
     problem, search = setup(*PROBLEMS[name], options, compile_mode)
     with tempfile.TemporaryDirectory() as cache:
-        cold, warm = build_seconds(name, cache, compile_mode), build_seconds(name, cache, compile_mode)
+        (cold, _), (warm, _) = build_seconds(name, cache, compile_mode), build_seconds(name, cache, compile_mode)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for start in range(starts):
@@ -129,6 +131,7 @@ def main() -> None:
                         help="an nlpsol option for every solve, e.g. ipopt.mumps_pivot_order=5 (a lever to measure)")
     parser.add_argument("--compile", help="the solver profile's compile mode (none, O0, O1, O2; default: the config's)")
     parser.add_argument("--build", metavar="CONFIG", help="only the build (cold, warm) of this config's full problem")
+    parser.add_argument("--repeat", type=int, default=1, help="warm builds to take the median of (with --build)")
     parser.add_argument("--build-only", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.build_only:
@@ -136,14 +139,17 @@ def main() -> None:
         from designopt.transcriptions import Collocation
         spec = PROBLEMS.get(args.build_only, (args.build_only, 0, "full"))  # a name, or any config's path
         problem, search = setup(*spec, compile_mode=args.compile)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         local.prepared(problem, Collocation(), search.profile)
-        print(time.perf_counter() - t0)
+        print(time.perf_counter() - t0, time.process_time() - c0)
         return
     if args.build:
         with tempfile.TemporaryDirectory() as cache:
-            cold, warm = build_seconds(args.build, cache, args.compile), build_seconds(args.build, cache, args.compile)
-        print(f"{args.build}: build cold {cold:.2f} s, warm {warm:.2f} s (new process each)")
+            cold = build_seconds(args.build, cache, args.compile)
+            warms = [build_seconds(args.build, cache, args.compile) for _ in range(args.repeat)]
+        wall, cpu = statistics.median(w for w, _ in warms), statistics.median(c for _, c in warms)
+        print(f"{args.build}: build cold {cold[0]:.2f} s (CPU {cold[1]:.3f} s), warm {wall:.2f} s (CPU {cpu:.3f} s; "
+              f"median of {args.repeat}; a new process each)")
         return
     if args.compare:
         old, new = (json.loads(p.read_text()) for p in args.compare)
