@@ -216,6 +216,39 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
     assert [t.stage for t, _ in stages[1]] == ["refine"] and len(searched.explore) == 4
 
 
+def test_an_explore_bound_holds_the_second_half_to_the_first_halfs_best(milling_12):
+    """``explore_bound``: the exploration's starts in two halves, numbered on; the second half held to
+    explore_bound x the first half's best objective after EXPLORE_BOUND_AFTER iterations, under the same profile
+    (one prepared solver); the rebranched starts of the round after are not held. 0: one round, nothing held."""
+    from designopt.solve.observers import Bound
+    from designopt.solve.strategies.coarse_to_fine import EXPLORE_BOUND_AFTER
+
+    problem = problem_from_config(parse_config(milling_12))
+    stages = []
+
+    def execute(tasks):
+        done = [(t, run_task(t)) for t in tasks]
+        stages.append(done)
+        return done
+
+    search = Search(starts=5, explore_waypoints=6, explore_max_iter=100, explore_bound=2.0, rebranch=1,
+                    screen_waypoints=0, refine=1, profile=SolverProfile(max_iter=200))
+    (searched,) = run_search([Job("", problem)], search, execute)
+    first, second, again = stages[0], stages[1], stages[2]
+    assert [t.start.number for t, _ in first] == [0, 1, 2] and [t.start.number for t, _ in second] == [3, 4]
+    best = min((s for _, s in first if s.metrics.tracks), key=lambda s: s.metrics.design_cost)
+    assert all(t.bound is None for t, _ in first)
+    assert all(t.bound == Bound(2.0 * best.raw.objective, EXPLORE_BOUND_AFTER) for t, _ in second)
+    assert all(t.profile == first[0][0].profile and "above_bound" in t.profile.observers for t, _ in second)
+    assert all(isinstance(t.start, Rebranched) and t.bound is None for t, _ in again)
+    assert len(searched.explore) == 5 + len(again)
+
+    stages.clear()
+    run_search([Job("", problem)], replace(search, explore_bound=0.0, rebranch=0), execute)
+    assert [t.start.number for t, _ in stages[0]] == [0, 1, 2, 3, 4] and [t.stage for t, _ in stages[1]] == ["refine"]
+    assert all(t.bound is None and "above_bound" not in t.profile.observers for t, _ in stages[0])
+
+
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     """Exploration within explore_max_iter, screening within screen_max_iter, refinement within the profile's
     max_iter: a screening solve only ranks, so a stalling one must not take the full budget (design only stalls
@@ -266,33 +299,34 @@ def test_a_problems_starts_go_to_few_workers(starts, workers):
 
 
 def test_a_bound_stops_a_feasible_solve_still_above_it_and_nothing_else():
-    from designopt.solve.observers import AboveBound, Iterate
+    from designopt.solve.observers import AboveBound, Bound, Iterate
 
     watch = AboveBound(None)
     q_d = np.zeros(3)
     for bound, iterate, expected in [
         (None, Iterate(q_d, 9.0, 0.0), False),  # no bound: never
-        (1.0, Iterate(q_d, 1.5, 0.0), True),  # feasible and above it
-        (1.0, Iterate(q_d, 0.5, 0.0), False),  # below it: on its way to beat it
-        (1.0, Iterate(q_d, 9.0, 0.1), False),  # not yet feasible: its objective says nothing
+        (Bound(1.0, 300), Iterate(q_d, 1.5, 0.0), True),  # feasible and above it
+        (Bound(1.0, 300), Iterate(q_d, 0.5, 0.0), False),  # below it: on its way to beat it
+        (Bound(1.0, 300), Iterate(q_d, 9.0, 0.1), False),  # not yet feasible: its objective says nothing
+        (Bound(1.0, 100), Iterate(q_d, 1.5, 0.0), True),  # the bound says when it applies
     ]:
         watch.reset(bound)
-        steps = [watch.observe(iterate, 5) for _ in range(AboveBound.after // 5)]
+        after = bound.after if bound else 300
+        steps = [watch.observe(iterate, 5) for _ in range(after // 5)]
         assert steps[:-1] == [False] * (len(steps) - 1)  # never before `after` iterations
         assert steps[-1] is expected and watch.stopped is expected
 
 
-def test_a_solve_given_a_bound_stops_at_it_with_its_status(milling_12, monkeypatch):
-    from designopt.solve.observers import AboveBound
+def test_a_solve_given_a_bound_stops_at_it_with_its_status(milling_12):
+    from designopt.solve.observers import Bound
 
-    monkeypatch.setattr(AboveBound, "after", 20)
     problem = coarse_problem(problem_from_config(parse_config(milling_12)), 6)
     profile = SolverProfile(max_iter=500, observers=("above_bound",))
     guess = initial_guess(problem, 1, 0, 0.3)
     free = solve_guess(problem, Collocation(), profile, guess)
     assert free.raw.status == "Solve_Succeeded" and free.raw.iterations > 30
-    held = solve_guess(problem, Collocation(), profile, guess, bound=0.5 * free.raw.objective)
+    held = solve_guess(problem, Collocation(), profile, guess, bound=Bound(0.5 * free.raw.objective, 20))
     assert held.raw.status == "Stopped_Above_Bound" and 20 <= held.raw.iterations < free.raw.iterations
     assert held.raw.objective > 0.5 * free.raw.objective
-    again = solve_guess(problem, Collocation(), profile, guess, bound=100.0 * free.raw.objective)
+    again = solve_guess(problem, Collocation(), profile, guess, bound=Bound(100.0 * free.raw.objective, 20))
     assert again.raw.status == "Solve_Succeeded" and again.raw.iterations == free.raw.iterations

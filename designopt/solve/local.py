@@ -16,6 +16,7 @@ import time
 from designopt.problem import DesignProblem
 from designopt.solution import Solution, solve_and_evaluate
 from designopt.solve.backends import backend_named
+from designopt.solve.observers import Bound
 from designopt.solve.profile import SolverProfile
 from designopt.transcriptions.base import InitialGuess, RawResult
 
@@ -47,8 +48,8 @@ def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
 
 
 def solve_guess(problem: DesignProblem, transcription, profile: SolverProfile, guess: InitialGuess,
-                bound: float | None = None) -> Solution:
-    """Solve the problem from ``guess`` (held to the objective ``bound`` if the profile observes "above_bound").
+                bound: Bound | None = None) -> Solution:
+    """Solve the problem from ``guess`` (held to ``bound`` if the profile observes "above_bound").
     A solve that fails is a solution with its status, not an exception."""
     built, solver, spent = prepared(problem, transcription, profile)
     outcome = solver.solve(built.pack(guess), bound)

@@ -1,7 +1,7 @@
 """Observers: watch a solve's iterates and may stop it; they never change the problem or the iterate.
 
 An observer is made per prepared solver from the problem (``OBSERVERS[name](problem)``); before each solve a
-backend calls ``reset(bound)`` (the solve's bound, `AboveBound`; None for most solves), then ``observe(iterate,
+backend calls ``reset(bound)`` (the solve's `Bound`, for `AboveBound`; None for most solves), then ``observe(iterate,
 iterations)`` with the current `Iterate` every few iterations (``iterations`` since the last call), and stops the
 solve when it returns True; the solve's status is then the observer's ``status``. What happens next (a
 continuation on another problem) is a strategy's business (`designopt.solve.strategies.continuation`).
@@ -27,6 +27,15 @@ class Iterate:
     violation: float = 0.0
 
 
+@dataclass(frozen=True)
+class Bound:
+    """What a solve is held to (`AboveBound`): once ``after`` iterations have passed, a feasible iterate whose NLP
+    objective is above ``objective`` stops it. A strategy sets both: what a start must beat, and how long it gets."""
+
+    objective: float
+    after: int
+
+
 class DegenerateWatch:
     """Stops a solve once its design has sat on a degenerate design (`held_at_multiples_of_pi` would hold
     something: every joint axis parallel to the workpiece normal, docs/decisions.md) for ``patience`` iterations
@@ -42,7 +51,7 @@ class DegenerateWatch:
         self._jacobian = None  # the tracking Jacobian, built at the first verdict and reused by every other one
         self.reset()
 
-    def reset(self, bound: float | None = None) -> None:
+    def reset(self, bound: Bound | None = None) -> None:
         self.run, self.stopped = 0, False
 
     def _degenerate(self, q_d: np.ndarray) -> bool:
@@ -63,28 +72,26 @@ class DegenerateWatch:
 
 
 class AboveBound:
-    """Stops a solve that, ``after`` iterations, still sits above its bound: a feasible iterate (violation <=
-    ``tol``, 1 mm or mrad) whose objective is above the bound the solve was given (``reset(bound)``). A start meant
-    to beat a known design that is still far above it by then rarely gets there: of the K = I sweep's neighbour
-    starts past 300 iterations (seeds 0 and 1, 365 solves), none that went on to beat its structure's best was then
-    above 1.73x it, and 241 of the 279 others were above 3x; on an untouched seed 4 of the 119 it stopped would have
-    beaten it, where other starts reached or beat those bests (docs/decisions.md). A solve without a bound is never
+    """Stops a solve that, ``bound.after`` iterations in, still sits above its bound: a feasible iterate
+    (violation <= ``tol``, 1 mm or mrad) whose objective is above ``bound.objective`` (the `Bound` the solve was
+    given, ``reset(bound)``). A start meant to beat a known design that is still far above it by then rarely gets
+    there; the strategies that set bounds (`designopt.solve.strategies.neighbours`, the exploration's second half in
+    `designopt.solve.strategies.coarse_to_fine`) say how each rule was measured. A solve without a bound is never
     stopped."""
 
     status = "Stopped_Above_Bound"
-    after = 300
 
     def __init__(self, problem: DesignProblem, tol: float = 1e-3):
         self.tol = tol
         self.reset()
 
-    def reset(self, bound: float | None = None) -> None:
+    def reset(self, bound: Bound | None = None) -> None:
         self.bound, self.iterations, self.stopped = bound, 0, False
 
     def observe(self, iterate: Iterate, iterations: int = 1) -> bool:
         self.iterations += iterations
-        self.stopped = (self.bound is not None and self.iterations >= self.after
-                        and iterate.violation <= self.tol and iterate.objective > self.bound)
+        self.stopped = (self.bound is not None and self.iterations >= self.bound.after
+                        and iterate.violation <= self.tol and iterate.objective > self.bound.objective)
         return self.stopped
 
 

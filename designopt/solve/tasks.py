@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from designopt.problem import DesignProblem
 from designopt.solution import Solution
 from designopt.solve.local import solve_guess
+from designopt.solve.observers import Bound
 from designopt.solve.profile import SolverProfile
 
 
@@ -25,7 +26,7 @@ class Task:
     profile: SolverProfile
     start: object  # designopt.solve.starts.Seeded | Lifted | Rebranched
     continuation: object | None = None  # e.g. designopt.solve.strategies.continuation.HoldDegenerate
-    bound: float | None = None  # an objective the solve is held to, if its profile observes "above_bound"
+    bound: Bound | None = None  # what the solve is held to, if its profile observes "above_bound"
 
     @property
     def method(self) -> str:

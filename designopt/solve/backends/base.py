@@ -7,6 +7,7 @@ from typing import Protocol
 
 import numpy as np
 
+from designopt.solve.observers import Bound
 from designopt.transcriptions.nlp import NLP
 
 
@@ -27,7 +28,7 @@ class Prepared(Protocol):
 
     prepare_time_s: float
 
-    def solve(self, x0: np.ndarray, bound: float | None = None) -> Outcome: ...
+    def solve(self, x0: np.ndarray, bound: Bound | None = None) -> Outcome: ...
 
 
 class Backend(Protocol):

@@ -19,7 +19,7 @@ import casadi as ca
 import numpy as np
 
 from designopt.solve.backends.base import Outcome
-from designopt.solve.observers import Iterate, make_observers
+from designopt.solve.observers import Bound, Iterate, make_observers
 from designopt.transcriptions.nlp import NLP
 
 # no_nlp_grad: nlpsol otherwise builds, at set-up, the reverse derivative of the whole NLP ("nlp_grad"), which it
@@ -116,8 +116,8 @@ class PreparedIpopt:
         self._casadi_warns = nlp.n_equalities + int(np.sum(nlp.lbx == nlp.ubx)) > nlp.n_variables
         self.prepare_time_s = time.perf_counter() - t0
 
-    def solve(self, x0: np.ndarray, bound: float | None = None) -> Outcome:
-        """Solve from x0 (clipped into the bounds); ``bound``: an objective the observers may hold the solve to
+    def solve(self, x0: np.ndarray, bound: Bound | None = None) -> Outcome:
+        """Solve from x0 (clipped into the bounds); ``bound``: what the observers may hold the solve to
         (`designopt.solve.observers.AboveBound`). A solve that fails is an outcome with its status."""
         nlp = self.nlp
         x0 = np.clip(np.asarray(x0, float), nlp.lbx, nlp.ubx)
