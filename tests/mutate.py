@@ -289,17 +289,6 @@ MUTATIONS = [
              "and iterate.objective > self.bound.objective", ("tests/test_search.py",)),
     Mutation("the backend does not hand a solve's bound to its observers",
              "designopt/solve/backends/ipopt.py", "o.reset(bound)", "o.reset()", ("tests/test_search.py",)),
-    Mutation("the exploration's second half held to the first start's objective, not the first half's best",
-             "designopt/solve/strategies/coarse_to_fine.py",
-             "best_solution([sol for _, sol in held[k]])", "best_solution([sol for _, sol in held[k]][:1])",
-             ("tests/test_search.py",)),
-    Mutation("the exploration's second half numbered from 0 again (the first half's starts solved twice)",
-             "designopt/solve/strategies/coarse_to_fine.py",
-             "explore_tasks(jobs, search, half, search.starts - half, explored)",
-             "explore_tasks(jobs, search, 0, search.starts - half, explored)", ("tests/test_search.py",)),
-    Mutation("a rebranched start keeps the bound of the exploration start it came from",
-             "designopt/solve/strategies/coarse_to_fine.py", "replace(first, start=start, bound=None)",
-             "replace(first, start=start)", ("tests/test_search.py",)),
 ]
 
 

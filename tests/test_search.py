@@ -216,39 +216,6 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
     assert [t.stage for t, _ in stages[1]] == ["refine"] and len(searched.explore) == 4
 
 
-def test_an_explore_bound_holds_the_second_half_to_the_first_halfs_best(milling_12):
-    """``explore_bound``: the exploration's starts in two halves, numbered on; the second half held to
-    explore_bound x the first half's best objective after EXPLORE_BOUND_AFTER iterations, under the same profile
-    (one prepared solver); the rebranched starts of the round after are not held. 0: one round, nothing held."""
-    from designopt.solve.observers import Bound
-    from designopt.solve.strategies.coarse_to_fine import EXPLORE_BOUND_AFTER
-
-    problem = problem_from_config(parse_config(milling_12))
-    stages = []
-
-    def execute(tasks):
-        done = [(t, run_task(t)) for t in tasks]
-        stages.append(done)
-        return done
-
-    search = Search(starts=5, explore_waypoints=6, explore_max_iter=100, explore_bound=2.0, rebranch=1,
-                    screen_waypoints=0, refine=1, profile=SolverProfile(max_iter=200))
-    (searched,) = run_search([Job("", problem)], search, execute)
-    first, second, again = stages[0], stages[1], stages[2]
-    assert [t.start.number for t, _ in first] == [0, 1, 2] and [t.start.number for t, _ in second] == [3, 4]
-    best = min((s for _, s in first if s.metrics.tracks), key=lambda s: s.metrics.design_cost)
-    assert all(t.bound is None for t, _ in first)
-    assert all(t.bound == Bound(2.0 * best.raw.objective, EXPLORE_BOUND_AFTER) for t, _ in second)
-    assert all(t.profile == first[0][0].profile and "above_bound" in t.profile.observers for t, _ in second)
-    assert all(isinstance(t.start, Rebranched) and t.bound is None for t, _ in again)
-    assert len(searched.explore) == 5 + len(again)
-
-    stages.clear()
-    run_search([Job("", problem)], replace(search, explore_bound=0.0, rebranch=0), execute)
-    assert [t.start.number for t, _ in stages[0]] == [0, 1, 2, 3, 4] and [t.stage for t, _ in stages[1]] == ["refine"]
-    assert all(t.bound is None and "above_bound" not in t.profile.observers for t, _ in stages[0])
-
-
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     """Exploration within explore_max_iter, screening within screen_max_iter, refinement within the profile's
     max_iter: a screening solve only ranks, so a stalling one must not take the full budget (design only stalls

@@ -75,9 +75,8 @@ class AboveBound:
     """Stops a solve that, ``bound.after`` iterations in, still sits above its bound: a feasible iterate
     (violation <= ``tol``, 1 mm or mrad) whose objective is above ``bound.objective`` (the `Bound` the solve was
     given, ``reset(bound)``). A start meant to beat a known design that is still far above it by then rarely gets
-    there; the strategies that set bounds (`designopt.solve.strategies.neighbours`, the exploration's second half in
-    `designopt.solve.strategies.coarse_to_fine`) say how each rule was measured. A solve without a bound is never
-    stopped."""
+    there; a strategy that sets bounds (`designopt.solve.strategies.neighbours`) says how its rule was measured. A
+    solve without a bound is never stopped."""
 
     status = "Stopped_Above_Bound"
 

@@ -26,9 +26,7 @@ class Search:
     ``starts`` seeded starts (from ``seed``; designs by ``spread``: perturbed by ``perturbation`` or drawn from the
     task's box, `designopt.initial_guess`; joints by ``init``): cold starts on
     the full path for ``multistart``; for ``coarse_to_fine`` the exploration's starts on ``explore_waypoints`` of
-    the path's waypoints (each capped at ``explore_max_iter``; with ``explore_bound`` > 0 in two halves, a start of
-    the second still above ``explore_bound`` times the first half's best objective after 100 iterations stopped:
-    `strategies.coarse_to_fine`), then the ``rebranch`` best distinct of their optima
+    the path's waypoints (each capped at ``explore_max_iter``), then the ``rebranch`` best distinct of their optima
     each started again ``starts // rebranch`` times (at least once) on a new joint branch (the optimum's design,
     first joints drawn over the whole circle: `designopt.solve.starts.Rebranched`; 0: none), explored alike; the
     ``screen`` best distinct of both rounds are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``;
@@ -49,7 +47,6 @@ class Search:
     init: str = "ik"
     explore_waypoints: int = 10
     explore_max_iter: int = 250
-    explore_bound: float = 0.0
     rebranch: int = 8
     screen_waypoints: int = 40
     screen: int = 12
@@ -75,11 +72,9 @@ class Search:
                   f"(<= {self.screen_max_iter} iterations, if the path has more)" if self.screen_waypoints else "")
         again = (f", the best {self.rebranch} distinct restarted {self.rebranch_starts} times each on a new joint "
                  f"branch" if self.rebranch else "")
-        halves = (f", the second half stopped if still above {self.explore_bound:g}x the first's best after 100 "
-                  f"iterations" if self.explore_bound else "")
         return (f"coarse to fine: {self.starts} starts on {self.explore_waypoints} waypoints (<= "
-                f"{self.explore_max_iter} iterations){halves}{again}{screen}, the best {self.refine} distinct optima "
-                f"refined on the full path ({cap}){held}")
+                f"{self.explore_max_iter} iterations){again}{screen}, the best {self.refine} distinct optima refined "
+                f"on the full path ({cap}){held}")
 
 
 # IPOPT options for design spaces whose tracking Jacobian goes rank-deficient on the way: a structure with fewer

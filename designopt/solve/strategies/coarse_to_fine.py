@@ -6,13 +6,10 @@ design optimal for the full path. Stages, each across every problem:
 
 1. ``explore``: ``search.starts`` cold seeded starts of the *coarse problem* -- the same robot, placement, costs and
    cell on ``explore_waypoints`` of the path's waypoints (`coarse_problem`) -- each capped at
-   ``explore_max_iter``. A coarse solve costs about a tenth of a full one. With ``explore_bound``, the starts go in
-   two halves, and a start of the second still above ``explore_bound`` times the first half's best objective after
-   ``EXPLORE_BOUND_AFTER`` iterations is stopped (`designopt.solve.observers.AboveBound`). Then the ``rebranch``
-   best distinct coarse optima are each started again ``starts // rebranch`` times with their design on a new joint
-   branch (first joints over the whole circle, `Rebranched`), explored alike and pooled with the first round: a
-   start lands in the best basin only when its design and its branch both fit, and good designs are where to look
-   for branches.
+   ``explore_max_iter``. A coarse solve costs about a tenth of a full one. Then the ``rebranch`` best distinct
+   coarse optima are each started again ``starts // rebranch`` times with their design on a new joint branch
+   (first joints over the whole circle, `Rebranched`), explored alike and pooled with the first round: a start lands in
+   the best basin only when its design and its branch both fit, and good designs are where to look for branches.
 2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    optima lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter`` and ranked again there:
    the coarse ranking alone often puts a design that lifts badly ahead of one that lifts well.
@@ -25,17 +22,12 @@ from __future__ import annotations
 from dataclasses import replace
 
 from designopt.problem import DesignProblem
-from designopt.solve.observers import Bound
-from designopt.solve.optima import best_solution, distinct_best
+from designopt.solve.optima import distinct_best
 from designopt.solve.search import Searched, by_job
 from designopt.solve.starts import Lifted, Rebranched
 from designopt.solve.strategies.steps import seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
-
-# The exploration's second half (``explore_bound``): a start still above explore_bound times the first half's best
-# objective after this many iterations is stopped (of the explore cap's 250).
-EXPLORE_BOUND_AFTER = 100
 
 
 def coarse_problem(problem: DesignProblem, waypoints: int) -> DesignProblem:
@@ -67,35 +59,17 @@ def rebranched_tasks(found, search) -> list[Task]:
             first, sol = done[i]
             for j in range(m):
                 start = Rebranched(sol, search.seed, search.starts + k * m + j, search.init)
-                tasks.append(replace(first, start=start, bound=None))
-    return tasks
-
-
-def explore_tasks(jobs, search, first: int, count: int, held=None) -> list[Task]:
-    """Every job's seeded starts ``first`` .. ``first + count - 1`` on its coarse problem; with ``held`` (a job's
-    first-half solutions, per job) each held to ``explore_bound`` times the best of them after
-    ``EXPLORE_BOUND_AFTER`` iterations (none where no first-half solve tracks)."""
-    profile = search.profile.capped(search.explore_max_iter)
-    if search.explore_bound:
-        profile = profile.observing("above_bound")  # one profile for both halves: one prepared solver
-    tasks = []
-    for k, job in enumerate(jobs):
-        bound = None
-        if held is not None and (best := best_solution([sol for _, sol in held[k]])) is not None:
-            bound = Bound(search.explore_bound * best.raw.objective, EXPLORE_BOUND_AFTER)
-        coarse = coarse_problem(job.problem, search.explore_waypoints)
-        tasks += seeded_tasks(job, "explore", coarse, profile, search, count, first, bound)
+                tasks.append(replace(first, start=start))
     return tasks
 
 
 def plan(jobs, search):
-    if search.explore_bound:
-        half = (search.starts + 1) // 2
-        explored = by_job(jobs, (yield explore_tasks(jobs, search, 0, half)))
-        more = by_job(jobs, (yield explore_tasks(jobs, search, half, search.starts - half, explored)))
-        explored = [first + rest for first, rest in zip(explored, more, strict=True)]
-    else:
-        explored = by_job(jobs, (yield explore_tasks(jobs, search, 0, search.starts)))
+    explore = []
+    for job in jobs:
+        coarse = coarse_problem(job.problem, search.explore_waypoints)
+        explore += seeded_tasks(job, "explore", coarse, search.profile.capped(search.explore_max_iter), search,
+                                search.starts)
+    explored = by_job(jobs, (yield explore))
     if search.rebranch:
         again = by_job(jobs, (yield rebranched_tasks(explored, search)))
         explored = [first + more for first, more in zip(explored, again, strict=True)]

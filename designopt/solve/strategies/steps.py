@@ -18,11 +18,9 @@ def solve_setup(job: Job, search: Search, profile=None):
     return profile, None
 
 
-def seeded_tasks(job: Job, stage: str, problem, profile, search: Search, count: int, first: int = 0,
-                 bound=None) -> list[Task]:
-    """``count`` seeded starts of ``problem`` (the job's, or a coarser sampling of it), numbered from ``first``,
-    each held to ``bound`` (a `designopt.solve.observers.Bound`, or None)."""
+def seeded_tasks(job: Job, stage: str, problem, profile, search: Search, count: int) -> list[Task]:
+    """``count`` seeded starts of ``problem`` (the job's, or a coarser sampling of it)."""
     profile, continuation = solve_setup(job, search, profile)
     return [Task(job.case, stage, problem, job.transcription, profile,
-                 Seeded(search.seed, i, search.perturbation, search.init, spread=search.spread), continuation, bound)
-            for i in range(first, first + count)]
+                 Seeded(search.seed, i, search.perturbation, search.init, spread=search.spread), continuation)
+            for i in range(count)]
