@@ -1,0 +1,98 @@
+"""Sweep structures searched alone (no neighbours) under variants of the config's search: cost against a reference.
+
+Each (structure, seed, variant) is the search `designopt sweep-structures` gives a structure (the config's preset,
+``solver.seed`` replaced), with the variant's fields of `designopt.solve.search.Search` replaced, solved in this
+process; the solver CPU and the best design cost are written to ``--json`` as each finishes (resumable). The table
+gives per variant how many runs end within 1.10x of the reference (``--references``, e.g. the sweep's kept
+large-budget costs), the geometric mean of the ratios and the CPU:
+
+    .venv/bin/python benchmarks/structure_budget.py RRRRRR RRRRR RRRR RRPRRR --seeds 0 1 2 3 4 5 \\
+        --variant quick: --variant rebranch4:rebranch=4 --variant starts80:starts=80 --json budget.json
+    .venv/bin/python benchmarks/structure_budget.py --table budget.json    # [STRUCTURES]: only those
+
+A structure of 4-6 joints takes 4-20 s of CPU per run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import pandas as pd
+
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
+from designopt.experiments.sweep import sweep_jobs
+from designopt.solve.strategies import run_search
+from designopt.solve.tasks import fan_out
+
+
+def variant(text: str) -> tuple[str, dict]:
+    """NAME:field=value,field=value -> (NAME, {field: int or float value})."""
+    name, _, fields = text.partition(":")
+    values = {}
+    for item in filter(None, fields.split(",")):
+        key, value = item.split("=", 1)
+        values[key] = float(value) if "." in value else int(value)
+    return name, values
+
+
+def run(config: Path, structures: list[str], seeds: list[int], variants: list[str], out: Path) -> None:
+    cfg = load_config(config)
+    rows = json.loads(out.read_text()) if out.exists() else []
+    have = {(r["structure"], r["seed"], r["variant"]) for r in rows}
+    for seed in seeds:
+        for structure in structures:
+            for name, fields in map(variant, variants):
+                if (structure, seed, name) in have:
+                    continue
+                search = replace(search_from_config(cfg), seed=seed, structure_neighbours=False, **fields)
+                cpu = 0.0
+
+                def execute(tasks):
+                    nonlocal cpu
+                    done = list(fan_out(tasks, 1))
+                    cpu += sum(s.raw.solve_time_s for _, s in done)
+                    return done
+
+                [searched] = run_search(sweep_jobs(cfg, [structure]), search, execute)
+                best = searched.best[1]
+                rows.append({"structure": structure, "seed": seed, "variant": name, "solve_s": cpu,
+                             "cost": float(best.metrics.design_cost) if best is not None else None})
+                out.write_text(json.dumps(rows))
+                print(structure, seed, name, rows[-1]["cost"], f"{cpu:.1f} s", flush=True)
+
+
+def table(files: list[Path], references: Path, structures: list[str]) -> None:
+    d = pd.concat(pd.DataFrame(json.loads(f.read_text())) for f in files)
+    ref = pd.read_csv(references).set_index("structure").reference_cost
+    d = d[d.structure.isin(structures or ref.index) & d.structure.isin(ref.index) & d.cost.notna()]
+    d["ratio"] = d.cost / d.structure.map(ref)
+    print("| variant | runs | within 1.10x | geometric mean | solver CPU |")
+    print("|---|---|---|---|---|")
+    for name, g in d.groupby("variant", sort=False):
+        print(f"| {name} | {len(g)} | {(g.ratio <= 1.10).sum()} | {math.exp(g.ratio.map(math.log).mean()):.3f} | "
+              f"{g.solve_s.sum():.0f} s |")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("structures", nargs="*")
+    parser.add_argument("--config", type=Path, default=Path("configs/structures.yaml"))
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0])
+    parser.add_argument("--variant", action="append", default=[], metavar="NAME:FIELD=VALUE,...")
+    parser.add_argument("--json", type=Path)
+    parser.add_argument("--table", type=Path, nargs="+", help="tabulate runs written with --json")
+    parser.add_argument("--references", type=Path, default=Path("benchmarks/reference/sweep_structures_k_i.csv"))
+    args = parser.parse_args()
+    if args.table:
+        table(args.table, args.references, args.structures)
+    else:
+        run(args.config, args.structures, args.seeds, args.variant or ["quick:"], args.json)
+
+
+if __name__ == "__main__":
+    main()
