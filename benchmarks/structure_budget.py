@@ -31,13 +31,21 @@ from designopt.solve.tasks import fan_out
 
 
 def variant(text: str) -> tuple[str, dict]:
-    """NAME:field=value,field=value -> (NAME, {field: int or float value})."""
+    """NAME:field=value,field=value -> (NAME, {field: value as an int, a float or else the text})."""
     name, _, fields = text.partition(":")
     values = {}
     for item in filter(None, fields.split(",")):
         key, value = item.split("=", 1)
-        values[key] = float(value) if "." in value else int(value)
+        values[key] = next((kind(value) for kind in (int, float) if _reads_as(kind, value)), value)
     return name, values
+
+
+def _reads_as(kind, text: str) -> bool:
+    try:
+        kind(text)
+    except ValueError:
+        return False
+    return True
 
 
 def run(config: Path, structures: list[str], seeds: list[int], variants: list[str], out: Path) -> None:
