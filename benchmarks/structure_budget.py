@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -29,23 +30,15 @@ from designopt.experiments.sweep import sweep_jobs
 from designopt.solve.strategies import run_search
 from designopt.solve.tasks import fan_out
 
+sys.path.insert(0, str(Path(__file__).parent))
+from structure_explore import option_value  # noqa: E402
+
 
 def variant(text: str) -> tuple[str, dict]:
     """NAME:field=value,field=value -> (NAME, {field: value as an int, a float or else the text})."""
     name, _, fields = text.partition(":")
-    values = {}
-    for item in filter(None, fields.split(",")):
-        key, value = item.split("=", 1)
-        values[key] = next((kind(value) for kind in (int, float) if _reads_as(kind, value)), value)
-    return name, values
-
-
-def _reads_as(kind, text: str) -> bool:
-    try:
-        kind(text)
-    except ValueError:
-        return False
-    return True
+    return name, {key: option_value(value) for key, value in
+                  (item.split("=", 1) for item in filter(None, fields.split(",")))}
 
 
 def run(config: Path, structures: list[str], seeds: list[int], variants: list[str], out: Path) -> None:

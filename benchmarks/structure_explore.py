@@ -33,7 +33,7 @@ from designopt.solve.tasks import fan_out
 CAPPED = "Maximum_Iterations_Exceeded"
 
 
-def _value(text: str):
+def option_value(text: str):
     """An option's value: an int or a float when it reads as one, else the string (IPOPT's yes / no stay strings)."""
     for kind in (int, float):
         try:
@@ -46,7 +46,7 @@ def _value(text: str):
 def explore(config: Path, structures: list[str], seed: int, options: list[str], jobs: int) -> list[dict]:
     cfg = load_config(config)
     search = replace(search_from_config(cfg), seed=seed)
-    given = tuple((k, _value(v)) for k, v in (o.split("=", 1) for o in options if o != "none"))
+    given = tuple((k, option_value(v)) for k, v in (o.split("=", 1) for o in options if o != "none"))
     own = () if "none" in options else search.profile.options
     search = replace(search, profile=replace(search.profile, options=(*own, *given)))
     tasks = []
