@@ -101,6 +101,56 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     return Q
 
 
+def projected(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations: int = 30,
+              tol: float = 1e-3) -> np.ndarray:
+    """``Q`` (N x n_moving) moved onto the path with the design ``q_d`` held: at every waypoint a damped
+    least-squares IK on the tracking residual (tool position in W [m], tool axis), within the joints' bounds,
+    from that waypoint's row of ``Q`` (so that it keeps its branch). A waypoint still further than ``tol`` from
+    its target then starts again from the waypoint before it, as a walk along the path does, and keeps the
+    better of the two. A waypoint's residual never grows."""
+    Q = np.array(Q, dtype=float)
+    everywhere = np.arange(len(Q))
+    Q, r = _moved_onto_path(problem, q_d, Q, everywhere, iterations)
+    for k in range(1, len(Q)):
+        if np.linalg.norm(r[k]) > tol:
+            walked, r_walked = _moved_onto_path(problem, q_d, Q[k - 1 : k], everywhere[k : k + 1], iterations)
+            if r_walked[0] @ r_walked[0] < r[k] @ r[k]:
+                Q[k], r[k] = walked[0], r_walked[0]
+    return Q
+
+
+def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks: np.ndarray, iterations: int):
+    """(Q, residuals): damped least squares at waypoints ``ks`` from the rows of ``Q`` (len(ks) x n_moving), each
+    waypoint with its own damping; a step that does not lower a waypoint's residual is not taken."""
+    n, n_m = Q.shape
+    fn = residual_function(problem).map(n)
+    S = problem.toolpath.points_W[ks].T
+    D = np.tile(np.asarray(q_d, float)[:, None], (1, n))
+    lo = np.array([j.lower for j in problem.chain.moving])
+    hi = np.array([j.upper for j in problem.chain.moving])
+
+    def evaluate(Q):  # residuals (n x 6) and Jacobians (n x 6 x n_m)
+        r, J_q, _ = fn(Q.T, D, S)
+        return np.array(r).T, np.array(J_q).reshape(6, n, n_m).transpose(1, 0, 2)
+
+    Q = np.array(Q, dtype=float)
+    r, J = evaluate(Q)
+    damping = np.full(n, 1e-2)
+    eye = np.eye(n_m)
+    for _ in range(iterations):
+        JT = J.transpose(0, 2, 1)
+        step = np.linalg.solve(JT @ J + damping[:, None, None] * eye, -(JT @ r[:, :, None]))[:, :, 0]
+        trial = np.clip(Q + step, lo, hi)
+        r_new, J_new = evaluate(trial)
+        off = np.sum(r**2, axis=1) >= 1e-14  # a waypoint on its target stays where it is
+        better = off & (np.sum(r_new**2, axis=1) < np.sum(r**2, axis=1))
+        Q[better], r[better], J[better] = trial[better], r_new[better], J_new[better]
+        damping = np.where(better, np.maximum(damping / 3, 1e-6), damping * 5)
+        if not off.any():
+            break
+    return Q, r
+
+
 def reach(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations: int = 60, samples=None):
     """A design near ``q_d`` and a trajectory near ``Q`` that follow the path: IK over the design joints too.
 

@@ -17,7 +17,8 @@ from hypothesis import strategies as st
 
 from designopt.config import parse_config
 from designopt.experiments.adapters import search_from_config
-from designopt.initial_guess import initial_guess, residual_function
+from designopt.costs import tracking_residual
+from designopt.initial_guess import ik_trajectory, initial_guess, projected, residual_function
 from designopt.problem import problem_from_config
 from designopt.solution import solve_and_evaluate
 from designopt.solve import (
@@ -114,6 +115,48 @@ def test_a_lifted_solution_starts_where_it_ended(milling_12):
     assert np.allclose(guess.Q[shared], sol.raw.Q, atol=1e-12)
     assert np.allclose(guess.V[shared], sol.raw.V, atol=1e-9)
     assert np.array_equal(guess.q_d, sol.raw.q_d)
+
+
+def test_a_lifted_start_is_on_the_path_between_the_coarse_knots(milling_12):
+    """Between a coarse solution's knots its trajectory leaves the path; the lifted start's waypoints are moved
+    onto it (`initial_guess.projected`) wherever the coarse design reaches: never further from it than the
+    trajectory, and most of them on it."""
+    full = problem_from_config(parse_config(milling_12))
+    sol = solve(coarse_problem(full, 6), max_iter=300)
+    assert sol.metrics.tracks
+    guess = lifted_guess(full, sol)
+    tp = full.toolpath
+
+    def errors(Q):  # the tracking residual at each waypoint (m and axis components together)
+        return np.array([np.linalg.norm(np.concatenate(tracking_residual(
+            full.waypoint(Q[k], guess.q_d, tp.points_W[k], tp.force_W[k])))) for k in range(tp.n)])
+
+    sampled, lifted = errors(sol.sample(tp.t)), errors(guess.Q)
+    assert np.median(sampled) > 0.1  # the spline between 6 knots leaves the path
+    assert np.all(lifted <= sampled + 1e-12)
+    assert np.sum(lifted < 1e-6) >= tp.n - 1
+
+
+def test_projection_moves_joints_onto_the_path_and_keeps_their_branch(milling_12):
+    """Joints on an IK trajectory, disturbed by 0.05 rad, return to the path near where they were (the arm is
+    redundant for a tool whose spin is free, so not to the same joints); rows already on the path do not move."""
+    problem = problem_from_config(parse_config(milling_12))
+    tp = problem.toolpath
+    q_d = np.array([j.value for j in problem.chain.design])
+    on_path = ik_trajectory(problem, q_d, np.full(problem.chain.n_moving, 0.3))
+    fn = residual_function(problem)
+
+    def residuals(Q):
+        return np.array([np.linalg.norm(np.array(fn(Q[k], q_d, tp.points_W[k])[0])) for k in range(tp.n)])
+
+    assert residuals(on_path).max() < 1e-7
+    disturbed = on_path + np.random.default_rng(5).normal(0.0, 0.05, on_path.shape)
+    disturbed[::3] = on_path[::3]
+    assert residuals(disturbed)[1::3].min() > 1e-3
+    back = projected(problem, q_d, disturbed)
+    assert residuals(back).max() < 1e-7
+    assert np.abs(back - on_path).max() < 0.2
+    assert np.array_equal(back[::3], on_path[::3])
 
 
 def test_distinct_best_takes_one_solution_per_optimum(milling_12):

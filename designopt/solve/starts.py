@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from designopt.initial_guess import design_named, initial_guess
+from designopt.initial_guess import design_named, initial_guess, projected
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
@@ -125,8 +125,9 @@ def grown_guess(problem: DesignProblem, source: DesignProblem, solution, where: 
 
 def lifted_guess(problem: DesignProblem, solution) -> InitialGuess:
     """A start for ``problem`` from a solution of another sampling of the same task: its design joints, and its
-    trajectory sampled at ``problem``'s waypoint times (the solution's own trajectory decides what lies between
-    its knots)."""
+    trajectory sampled at ``problem``'s waypoint times, each sample moved onto the path (`projected`: between
+    the solution's knots its trajectory may leave the path by decimetres and turn the tool over)."""
     t = problem.toolpath.t
-    return InitialGuess(q_d=np.asarray(solution.raw.q_d, float), Q=solution.sample(t), V=solution.sample_velocity(t),
+    q_d = np.asarray(solution.raw.q_d, float)
+    return InitialGuess(q_d=q_d, Q=projected(problem, q_d, solution.sample(t)), V=solution.sample_velocity(t),
                         seed=solution.raw.seed)
