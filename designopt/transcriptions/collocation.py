@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+import designopt.transcriptions.quadratic as quadratic_terms
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess, waypoint_function
 from designopt.transcriptions.nlp import (
@@ -30,15 +31,13 @@ from designopt.transcriptions.nlp import (
     clearance_terms,
     floor_terms,
     free_untracked,
-    joint_regularization,
     once_only_rows,
-    quadratic_design_costs,
     tracking_rows,
     waypoint_inputs,
     waypoint_terms,
     y_indices,
 )
-from designopt.transcriptions.trajectory import HermiteCubic, hermite_acceleration_integral, hermite_midpoint
+from designopt.transcriptions.trajectory import HermiteCubic, hermite_midpoint
 
 
 @dataclass(frozen=True)
@@ -127,12 +126,14 @@ class CollocationNLP:
 
         Q0, V0, Q1, V1 = Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:]
         Q_mid, V_mid = hermite_midpoint(Q0, V0, Q1, V1, h)
-        quadratic = quadratic_design_costs(problem, q_d)
+        q_index = n_d + np.arange(N)[:, None] * self.n_state + np.arange(n_m)[None, :]
         # The smoothness term must stay small against the design cost: the figure-eight needs joint
         # accelerations of ~100 rad per unit task time squared, so 1e-6 already outweighed L_d (measured).
-        accel = ca.sum1(ca.sum2(hermite_acceleration_integral(Q0, V0, Q1, V1, h)))
-        quadratic += problem.smoothness * accel + joint_regularization(problem, Q, tp.dt if tp.uniform else tp.weights)
-        objective = ca.sum2(Phi) + quadratic
+        quadratic = (*quadratic_terms.design_costs(problem, np.arange(n_d)),
+                     quadratic_terms.smoothness(problem, q_index, q_index + n_m,
+                                                np.full(N - 1, tp.dt) if tp.uniform else tp.h),
+                     quadratic_terms.joint_regularization(problem, q_index, tp.weights))
+        objective = ca.sum2(Phi) + quadratic_terms.total(quadratic, x)
 
         cons = ConstraintList()
         n_c = C.shape[0]

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+import designopt.transcriptions.quadratic as quadratic_terms
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 from designopt.transcriptions.nlp import (
@@ -25,8 +26,6 @@ from designopt.transcriptions.nlp import (
     BlockStructure,
     ConstraintList,
     free_untracked,
-    joint_regularization,
-    quadratic_design_costs,
     tracking_rows,
     waypoint_inputs,
     waypoint_terms,
@@ -80,9 +79,10 @@ class ForwardKinematicsNLP:
         x = ca.vertcat(q_d, ca.vec(Q))
         terms, c_lo, c_hi = waypoint_terms(problem, "epsilon", epsilon=self.epsilon)
         Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), *waypoint_inputs(tp))
-        quadratic = joint_regularization(problem, Q, tp.dt if tp.uniform else tp.weights) \
-            + quadratic_design_costs(problem, q_d)
-        objective = ca.sum2(Phi) + quadratic
+        q_index = n_d + np.arange(N)[:, None] * n_m + np.arange(n_m)[None, :]
+        quadratic = (quadratic_terms.joint_regularization(problem, q_index, tp.weights),
+                     *quadratic_terms.design_costs(problem, np.arange(n_d)))
+        objective = ca.sum2(Phi) + quadratic_terms.total(quadratic, x)
 
         cons = ConstraintList()
         n_c = C.shape[0]

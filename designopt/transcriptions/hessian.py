@@ -3,7 +3,8 @@
 Every nonlinear term of the transcribed problems lives at one waypoint and depends only on
 y_k = (q_k, q_d): the waypoint's moving joints and the design joints. The Lagrangian is therefore
     L(x) = sum_k [sigma phi_k(y_k) + mu_k . c_k(y_k)] + sigma * (quadratic terms),
-and its Hessian is a sum of dense (n_m + n_d)^2 blocks scattered into one sparse matrix plus a constant.
+and its Hessian is a sum of dense (n_m + n_d)^2 blocks scattered into one sparse matrix plus a constant (the
+quadratic terms', `designopt.transcriptions.quadratic.constant_hessian`).
 Evaluating one small (optionally compiled) block function N times is far cheaper than CasADi's generic
 Hessian of the whole graph, which must colour the dense design-joint columns.
 """

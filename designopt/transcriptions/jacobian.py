@@ -7,8 +7,9 @@ So dg/dx is the small Jacobians dc/dy of one (optionally compiled) block functio
 scattered into one sparse matrix, plus the Jacobian of the remaining rows, which CasADi derives from their own,
 small expressions. Deriving it from the whole SX graph instead colours the dense design-joint columns: most of
 the NLP's build time (0.17 s of the main job's, 4.1 s of the pocket cell's; benchmarks/speed_table.py).
-Likewise the objective f(x) = sum_k phi_k(y_k) + quadratic(x): its gradient is the blocks' dphi/dy scattered and
-added, plus the quadratic terms' own (small) gradient, instead of a reverse sweep of the whole graph.
+Likewise the objective f(x) = sum_k phi_k(y_k) + the quadratic terms (`designopt.transcriptions.quadratic`, each
+also a sum over points): its gradient is the blocks' and the quadratic terms' d/dy scattered and added, instead
+of a reverse sweep of the whole graph.
 """
 
 from __future__ import annotations
@@ -82,18 +83,17 @@ def block_gradient_function(terms: ca.Function, compile_mode: str) -> ca.Functio
     return compiled(ca.Function("block_gradient", [y, *params], [ca.densify(grad)]), compile_mode)
 
 
-def assemble_gradient(x, quadratic_gradient, f_of: ca.Function,
+def assemble_gradient(n_x: int, f_of: ca.Function,
                       groups: list[tuple[ca.Function | None, np.ndarray, list]]) -> ca.Function:
-    """grad_f(x, p) -> (f, df/dx), for nlpsol's ``grad_f`` option, of f(x) = sum over the blocks' points of
-    phi_k(y_k) + ``quadratic``(x).
+    """grad_f(x, p) -> (f, df/dx), for nlpsol's ``grad_f`` option, of f(x) = the sum over the groups' points of
+    each group's term at y_k (the per-waypoint phi_k(y_k), the quadratic terms).
 
-    ``x``: the NLP's SX decision vector; ``quadratic_gradient``: the gradient of the quadratic terms as an SX
-    column of it (None: there are none; `designopt.transcriptions.nlp.quadratic_derivatives`); ``f_of``: x -> f.
-    Each group is (block, y_index, block_inputs) with ``block`` from `block_gradient_function` (None: no objective
-    term), ``y_index`` (N x n_y) the position in x of each block variable and ``block_inputs`` the block's constant
-    extra inputs (mapped). Contributions to one entry add up.
+    ``n_x``: the length of x; ``f_of``: x -> f. Each group is (block, y_index, block_inputs) with ``block`` the
+    term's gradient (y, *inputs) -> d/dy (`block_gradient_function`,
+    `designopt.transcriptions.quadratic.gradient_groups`; None: no objective term), ``y_index`` (N x n_y) the
+    position in x of each block variable and ``block_inputs`` the block's constant extra inputs (mapped).
+    Contributions to one entry add up.
     """
-    n_x = x.shape[0]
     X = ca.MX.sym("x", n_x)
     P = ca.MX.sym("p", 0, 1)
     values, rows = [], []
@@ -105,6 +105,4 @@ def assemble_gradient(x, quadratic_gradient, f_of: ca.Function,
     # one 1 per column: block entry e adds to entry rows[e] of the gradient
     scatter = ca.DM(ccs_sparsity(n_x, len(rows), rows, np.arange(len(rows))), 1.0)
     grad = ca.mtimes(scatter, ca.vertcat(*values)) if len(rows) else ca.MX(n_x, 1)
-    if quadratic_gradient is not None:
-        grad += ca.Function("grad_quadratic", [x], [ca.densify(quadratic_gradient)])(X)
     return ca.Function("grad_f", [X, P], [f_of(X), grad], ["x", "p"], ["f", "grad_f_x"])

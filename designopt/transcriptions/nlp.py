@@ -23,6 +23,7 @@ from designopt.transcriptions.jacobian import (
     block_gradient_function,
     block_jacobian_function,
 )
+from designopt.transcriptions.quadratic import QuadraticTerm, constant_hessian, gradient_groups
 
 
 @dataclass
@@ -61,12 +62,14 @@ class BlockStructure:
 class NLP:
     """A transcribed problem, backend-neutral: decision vector ``x``, objective ``f``, constraints ``g`` (CasADi SX)
     and their bounds, plus where the per-point nonlinear terms sit (``blocks``), from which `hessian` assembles
-    the exact Hessian of the Lagrangian; ``quadratic`` is the part of ``f`` whose Hessian is constant.
+    the exact Hessian of the Lagrangian; ``quadratic`` are the terms of ``f`` whose Hessian is constant
+    (`designopt.transcriptions.quadratic`).
 
     Built once per problem shape; a backend (`designopt.solve.backends`) turns it into a solver. The design
     joints come first in ``x`` (x[:n_design])."""
 
-    def __init__(self, problem: DesignProblem, name: str, x, objective, quadratic, constraints: ConstraintList,
+    def __init__(self, problem: DesignProblem, name: str, x, objective, quadratic: tuple[QuadraticTerm, ...],
+                 constraints: ConstraintList,
                  lbx, ubx, blocks: list[BlockStructure] | None):
         self.problem, self.name = problem, name
         self.x, self.f = x, objective
@@ -93,7 +96,7 @@ class NLP:
             groups = [(block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1], compile_mode),
                        b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
             self._hessians[compile_mode] = assemble_hessian(self.n_variables, self.n_constraints, groups,
-                                                            self._quadratic_derivatives[1])
+                                                            self._constant_hessian)
         return self._hessians[compile_mode]
 
     def jacobian(self, compile_mode: str):
@@ -121,15 +124,15 @@ class NLP:
             return None
         if compile_mode not in self._gradients:
             groups = [(block_gradient_function(b.terms, compile_mode), b.y_index, self._inputs(b)) for b in self.blocks]
-            self._gradients[compile_mode] = assemble_gradient(self.x, self._quadratic_derivatives[0],
-                                                              self._functions[0], groups)
+            self._gradients[compile_mode] = assemble_gradient(self.n_variables, self._functions[0],
+                                                              groups + gradient_groups(self.quadratic))
         return self._gradients[compile_mode]
 
     @functools.cached_property
-    def _quadratic_derivatives(self) -> tuple:
-        """(gradient, Hessian triplets) of the quadratic terms (`quadratic_derivatives`), derived once for both the
-        gradient and the Hessian of the NLP."""
-        return quadratic_derivatives(self.quadratic, self.x)
+    def _constant_hessian(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The quadratic terms' Hessian as triplets (`designopt.transcriptions.quadratic.constant_hessian`), shared
+        by the hess_lag of every compile mode."""
+        return constant_hessian(self.quadratic)
 
     @functools.cached_property
     def _oracle(self) -> dict:
@@ -148,20 +151,6 @@ class NLP:
             return {"x": self.x, "f": self.f, "g": self.g}, {}
         return self._oracle, {"hess_lag": self.hessian(compile_mode), "jac_g": self.jacobian(compile_mode),
                               "grad_f": self.gradient(compile_mode)}
-
-
-def quadratic_derivatives(quadratic, x) -> tuple:
-    """(gradient, (rows, cols, values)) of the quadratic terms: the gradient as an SX column of ``x`` (None when
-    there are no quadratic terms) and the constant Hessian as sparse upper-triangular triplets. One symbolic
-    Hessian yields both (on the main job it takes 0.034 s; a gradient taken again would add 0.012 s)."""
-    if isinstance(quadratic, (int, float)):
-        return None, (np.zeros(0, int), np.zeros(0, int), np.zeros(0))
-    H, gradient = ca.hessian(quadratic, x)
-    H = ca.evalf(ca.triu(H))
-    rows, cols = H.sparsity().get_triplet()
-    values = np.array(H.nonzeros(), dtype=float)
-    keep = values != 0
-    return gradient, (np.asarray(rows, int)[keep], np.asarray(cols, int)[keep], values[keep])
 
 
 def y_indices(n_d: int, n_m: int, N: int, stride: int) -> np.ndarray:
@@ -184,16 +173,6 @@ def free_untracked(problem: DesignProblem, lo: np.ndarray, hi: np.ndarray, rows:
     free = ~problem.toolpath.is_tracked
     lo[np.ix_(rows, free)], hi[np.ix_(rows, free)] = -np.inf, np.inf
     return lo, hi
-
-
-def joint_regularization(problem: DesignProblem, Q, h):
-    """sum_k w_k * weight * |q_k|^2: removes exact null directions (a constant joint offset against the
-    placement yaw; rotation about the tool axis) that otherwise stall IPOPT. Weight: costs.joint_regularization,
-    small enough to stay well below 1 % of the design cost on the default problem. ``h``: the time step of a
-    uniform path, or the N quadrature weights."""
-    if np.ndim(h) == 0:
-        return problem.joint_regularization * h * ca.sumsqr(Q)
-    return problem.joint_regularization * ca.sum2(ca.DM(np.asarray(h)[None, :]) * ca.sum1(Q * Q))
 
 
 TRACKING_ACTIVATIONS = ("hard", "soft", "epsilon")
@@ -279,15 +258,6 @@ def floor_terms(problem: DesignProblem) -> ca.Function:
     q_d = ca.SX.sym("q_d", problem.chain.n_design)
     c = ca.vertcat(*block_above_floor(problem.chain, problem.cell, q_d))
     return ca.Function("block_floor", [q_d], [ca.SX(0), c], ["y"], ["phi", "c"])
-
-
-def quadratic_design_costs(problem: DesignProblem, q_d):
-    """The quadratic design terms (e.g. L_r): their Hessian is constant and joins the NLP's constant part."""
-    total = 0
-    for cost in problem.design_costs:
-        if cost.quadratic:
-            total += cost(problem.chain, q_d)
-    return total
 
 
 def once_only_rows(problem: DesignProblem, tracking: str) -> np.ndarray:
