@@ -16,8 +16,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designopt.config import parse_config
-from designopt.experiments.adapters import search_from_config
 from designopt.costs import tracking_residual
+from designopt.experiments.adapters import search_from_config
 from designopt.initial_guess import ik_trajectory, initial_guess, projected, residual_function
 from designopt.problem import problem_from_config
 from designopt.solution import solve_and_evaluate
