@@ -19,6 +19,8 @@ from designopt.solve import SolverProfile
 from designopt.solve.local import prepared
 from designopt.transcriptions import Collocation
 from designopt.transcriptions.compiled import compiled
+from designopt.transcriptions.forward_kinematics import ForwardKinematics
+from designopt.transcriptions.nlp import split_terms
 from designopt.transcriptions.trajectory import hermite_acceleration_integral, hermite_midpoint
 
 
@@ -91,6 +93,37 @@ def test_structured_hessian_equals_casadi_hessian(tracking, keep_out, rng):
         a = np.triu(np.array(ca.DM(H_ours(x, [], lam_f, lam_g))))
         b = np.triu(np.array(ca.DM(H_ref(x, [], lam_f, lam_g))))
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("transcription,keep_out", [(Collocation(), 0.2), (ForwardKinematics(), 0.0)])
+def test_objective_and_constraints_from_blocks_equal_the_whole_graphs(transcription, keep_out, rng):
+    """The NLP a backend solves takes f and g from its blocks' own terms (each split into phi and c, mapped over
+    their points) plus the quadratic terms and the rows in no block; they equal the transcription's whole SX f
+    and g, interpreted and compiled."""
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 7},
+           "robot": {"structure": "RPRR", "dh": "generic"},
+           "placement": {"xyz": [0.4, 0.1, 0.0], "keep_out_radius": keep_out}}
+    nlp = transcription.build(problem_from_config(parse_config(cfg))).nlp
+    ref = ca.Function("ref", [nlp.x], [nlp.f, nlp.g])
+    for mode in ("none", "O0"):
+        f_of, g_of = nlp.functions(mode)
+        for _ in range(3):
+            x = rng.normal(size=nlp.n_variables)
+            f, g = ref(x)
+            np.testing.assert_allclose(float(f_of(x)), float(f), rtol=1e-12)
+            np.testing.assert_allclose(np.array(g_of(x)), np.array(g), rtol=1e-12, atol=1e-14)
+
+
+def test_a_block_without_an_objective_term_is_not_evaluated_for_f():
+    """A clearance block's phi is structurally zero: `split_terms` gives no phi function for it, so that f does
+    not evaluate the cell's clearance, and a waypoint block gives both."""
+    y = ca.SX.sym("y", 3)
+    only_c = ca.Function("clear", [y], [ca.SX(0), ca.sumsqr(y)])
+    both = ca.Function("terms", [y], [ca.sin(y[0]), y[1:] * 2])
+    phi, c = split_terms(only_c)
+    assert phi is None and float(c([1, 2, 3])) == 14
+    phi, c = split_terms(both)
+    assert float(phi([0.5, 1, 1])) == pytest.approx(np.sin(0.5)) and list(np.array(c([0, 1, 2])).ravel()) == [2, 4]
 
 
 def test_compiled_block_gives_the_same_hessian(rng, tmp_path, monkeypatch):

@@ -1,5 +1,6 @@
 """The part every transcription shares: per-waypoint terms in y_k = (q_k, q_d) and the backend-neutral `NLP` whose
-exact Hessian is assembled from per-waypoint blocks.
+objective, constraints and their derivatives (the exact Hessian, the constraint Jacobian, the gradient) are
+assembled from per-waypoint blocks.
 
 A transcription decides the decision vector layout, the objective and the constraints; `NLP` holds them for a
 backend (`designopt.solve.backends`) to solve.
@@ -15,15 +16,16 @@ import numpy as np
 
 from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
+from designopt.transcriptions.compiled import compiled
 from designopt.transcriptions.degeneracy import q_independent_rows
-from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function
+from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function, block_symbols, per_point
 from designopt.transcriptions.jacobian import (
     assemble_gradient,
     assemble_jacobian,
     block_gradient_function,
     block_jacobian_function,
 )
-from designopt.transcriptions.quadratic import QuadraticTerm, constant_hessian, gradient_groups
+from designopt.transcriptions.quadratic import QuadraticTerm, constant_hessian, gradient_groups, total
 
 
 @dataclass
@@ -82,6 +84,7 @@ class NLP:
         self._hessians: dict[str, object] = {}
         self._jacobians: dict[str, object] = {}
         self._gradients: dict[str, object] = {}
+        self._values: dict[str, tuple[ca.Function, ca.Function]] = {}
 
     def _inputs(self, block: BlockStructure) -> list:
         """A block's constant inputs, one column per point (the toolpath's `waypoint_inputs` unless it has its own)."""
@@ -107,14 +110,24 @@ class NLP:
         if compile_mode not in self._jacobians:
             groups = [(*block_jacobian_function(b.terms, compile_mode), b.y_index, self._inputs(b), b.mu_index)
                       for b in self.blocks]
-            self._jacobians[compile_mode] = assemble_jacobian(self.x, self.g, self._functions[1], groups)
+            self._jacobians[compile_mode] = assemble_jacobian(self.x, self.g, self.functions(compile_mode)[1],
+                                                              groups)
         return self._jacobians[compile_mode]
 
-    @functools.cached_property
-    def _functions(self) -> tuple[ca.Function, ca.Function]:
-        """(x -> f, x -> g): the objective and the constraints as SX functions, set up once (on a long program
-        each takes seconds) and shared by the oracle and jac_g."""
-        return ca.Function("nlp_f", [self.x], [self.f]), ca.Function("nlp_g", [self.x], [self.g])
+    def functions(self, compile_mode: str) -> tuple[ca.Function, ca.Function]:
+        """(x -> f, x -> g), shared by the oracle, grad_f and jac_g. With blocks, both are assembled from the
+        blocks' own terms (each compiled per ``compile_mode``), mapped over their points, plus the quadratic terms
+        and the constraint rows in no block (`assemble_values`): CasADi's virtual machine interpreting the whole SX
+        graph instead was a fifth of a cell problem's iteration. Without blocks, SX functions of f and g."""
+        if compile_mode not in self._values:
+            if self.blocks is None:
+                self._values[compile_mode] = (ca.Function("nlp_f", [self.x], [self.f]),
+                                              ca.Function("nlp_g", [self.x], [self.g]))
+            else:
+                groups = [(*(None if fn is None else compiled(fn, compile_mode) for fn in split_terms(b.terms)),
+                           b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
+                self._values[compile_mode] = assemble_values(self.x, self.g, groups, self.quadratic)
+        return self._values[compile_mode]
 
     def gradient(self, compile_mode: str):
         """grad_f(x, p) -> (f, df/dx): the blocks' dphi/dy scattered, plus the gradient of the quadratic terms
@@ -124,7 +137,7 @@ class NLP:
             return None
         if compile_mode not in self._gradients:
             groups = [(block_gradient_function(b.terms, compile_mode), b.y_index, self._inputs(b)) for b in self.blocks]
-            self._gradients[compile_mode] = assemble_gradient(self.n_variables, self._functions[0],
+            self._gradients[compile_mode] = assemble_gradient(self.n_variables, self.functions(compile_mode)[0],
                                                               groups + gradient_groups(self.quadratic))
         return self._gradients[compile_mode]
 
@@ -134,23 +147,70 @@ class NLP:
         by the hess_lag of every compile mode."""
         return constant_hessian(self.quadratic)
 
-    @functools.cached_property
-    def _oracle(self) -> dict:
-        """The NLP for nlpsol as MX calls of the SX functions `_functions`."""
+    def _oracle(self, compile_mode: str) -> dict:
+        """The NLP for nlpsol as calls of `functions`."""
         X = ca.MX.sym("x", self.n_variables)
-        f_of, g_of = self._functions
+        f_of, g_of = self.functions(compile_mode)
         return {"x": X, "f": f_of(X), "g": g_of(X)}
 
     def derivatives(self, compile_mode: str) -> tuple[dict, dict]:
         """(the NLP for nlpsol, the derivative functions for its options): with blocks, hess_lag, jac_g and
-        grad_f are given and the NLP is an MX call of SX functions, so that nlpsol derives nothing itself
+        grad_f are given and the NLP is f and g assembled from the blocks (`functions`), so that nlpsol derives
+        nothing itself
         (it otherwise spends seconds on the SX graph of a cell problem: 6.5 s of the pocket cell's 7.3 s build,
         benchmarks/speed_table.py); without blocks the SX NLP, for nlpsol to differentiate. Every piece is built
         once per NLP and shared by the solvers of all its profiles."""
         if self.blocks is None:
             return {"x": self.x, "f": self.f, "g": self.g}, {}
-        return self._oracle, {"hess_lag": self.hessian(compile_mode), "jac_g": self.jacobian(compile_mode),
-                              "grad_f": self.gradient(compile_mode)}
+        return self._oracle(compile_mode), {"hess_lag": self.hessian(compile_mode),
+                                            "jac_g": self.jacobian(compile_mode),
+                                            "grad_f": self.gradient(compile_mode)}
+
+
+def split_terms(terms: ca.Function) -> tuple[ca.Function | None, ca.Function | None]:
+    """A block's (y, *inputs) -> (phi, c) as two functions, (y, *inputs) -> phi and (y, *inputs) -> c, so that
+    evaluating f does not evaluate c nor g phi; None for an output that is structurally zero (a clearance block's
+    phi) or empty."""
+    y, params = block_symbols(terms)
+    phi, c = terms(y, *params)
+    return (None if phi.is_zero() else ca.Function(f"{terms.name()}_phi", [y, *params], [phi]),
+            ca.Function(f"{terms.name()}_c", [y, *params], [c]) if c.numel() else None)
+
+
+def assemble_values(x, g, groups: list[tuple[ca.Function | None, ca.Function | None, np.ndarray, list, np.ndarray]],
+                    quadratic: tuple[QuadraticTerm, ...]) -> tuple[ca.Function, ca.Function]:
+    """(x -> f, x -> g) of an NLP whose nonlinear terms sit in per-point blocks, as MX functions.
+
+    ``x``, ``g``: the NLP's SX decision vector and constraints (the rows in no block are taken from ``g``'s own,
+    small expressions). Each group is (phi, c, y_index, block_inputs, mu_index): a block's (y, *inputs) -> phi and
+    (y, *inputs) -> c (`split_terms`; None: none), ``y_index`` (N x n_y) the position in x of each block variable,
+    ``block_inputs`` its constant extra inputs (mapped) and ``mu_index`` (N x n_c) the position in g of each row
+    of c. f = the blocks' phi summed over their points + the ``quadratic`` terms; every row of g comes from
+    exactly one block or from ``g``.
+    """
+    n_x, n_g = x.shape[0], g.shape[0]
+    X = ca.MX.sym("x", n_x)
+    f, values, rows = total(quadratic, X), [], []
+    for phi, c, y_index, block_inputs, mu_index in groups:
+        at = per_point(X, y_index)
+        if phi is not None:
+            f += ca.sum2(phi.map(y_index.shape[0])(at, *block_inputs))
+        if c is not None and mu_index.size:
+            values.append(ca.vec(c.map(y_index.shape[0])(at, *block_inputs)))  # point by point, as mu_index
+            rows.append(mu_index.ravel())
+    in_block = np.zeros(n_g, dtype=bool)
+    for r in rows:
+        if np.any(in_block[r]):
+            raise ValueError("two blocks claim the same constraint row")
+        in_block[r] = True
+    rest = np.flatnonzero(~in_block)
+    if rest.size:
+        values.append(ca.Function("g_rest", [x], [g[ca.DM(rest.tolist())]])(X))
+        rows.append(rest)
+    position = np.empty(n_g, dtype=int)
+    position[np.concatenate([*rows, np.zeros(0, int)])] = np.arange(n_g)
+    G = ca.vertcat(*values)[ca.DM(position.tolist())] if n_g else ca.MX(0, 1)
+    return ca.Function("nlp_f", [X], [f]), ca.Function("nlp_g", [X], [G])
 
 
 def y_indices(n_d: int, n_m: int, N: int, stride: int) -> np.ndarray:
