@@ -209,6 +209,8 @@ MUTATIONS = [
     Mutation("the quadratic terms left out of the objective's value", "designopt/transcriptions/nlp.py",
              "    f, values, rows = total(quadratic, X), [], []", "    f, values, rows = ca.MX(0), [], []",
              ("tests/test_collocation.py", "tests/test_transcriptions.py")),
+    Mutation("compile auto never compiles a long path's blocks at O1", "designopt/transcriptions/compiled.py",
+             '    return "O1" if points >= AUTO_O1_FROM else "O0"', '    return "O0"', ("tests/test_collocation.py",)),
     Mutation("the quadratic terms' Hessian values scattered entry by entry, not point by point",
              "designopt/transcriptions/quadratic.py", "v.reshape(len(a), n_points).T.ravel()",
              "v.reshape(n_points, len(a)).ravel()", ("tests/test_quadratic.py", "tests/test_transcriptions.py")),

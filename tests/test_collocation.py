@@ -18,7 +18,7 @@ from designopt.problem import problem_from_config
 from designopt.solve import SolverProfile
 from designopt.solve.local import prepared
 from designopt.transcriptions import Collocation
-from designopt.transcriptions.compiled import compiled
+from designopt.transcriptions.compiled import AUTO_O1_FROM, compiled, level
 from designopt.transcriptions.forward_kinematics import ForwardKinematics
 from designopt.transcriptions.nlp import split_terms
 from designopt.transcriptions.trajectory import hermite_acceleration_integral, hermite_midpoint
@@ -137,6 +137,26 @@ def test_compiled_block_gives_the_same_hessian(rng, tmp_path, monkeypatch):
     Ha = np.array(ca.DM(fa(x, [], 1.0, lam_g)))
     Hb = np.array(ca.DM(fb(x, [], 1.0, lam_g)))
     np.testing.assert_allclose(Ha, Hb, rtol=1e-12, atol=1e-12)
+
+
+def test_auto_compiles_blocks_of_long_paths_at_o1(monkeypatch):
+    """``auto`` (the profile's default) compiles a block evaluated at AUTO_O1_FROM points or more at O1 and one
+    at fewer points at O0; any other mode is itself, and a block is never compiled at "auto"."""
+    import designopt.transcriptions.hessian as hessian_module
+
+    assert level("auto", AUTO_O1_FROM) == "O1" and level("auto", AUTO_O1_FROM - 1) == "O0"
+    assert level("none", 10**6) == "none" and level("O2", 1) == "O2" and SolverProfile().compile == "auto"
+    x = ca.SX.sym("x")
+    with pytest.raises(ValueError, match="auto"):
+        compiled(ca.Function("f", [x], [x**2]), "auto")
+    asked = []
+    monkeypatch.setattr(hessian_module, "compiled_as", lambda name, identity, derive, mode: asked.append(mode) or
+                        derive())
+    for n, expected in ((AUTO_O1_FROM, "O1"), (12, "O0")):
+        cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": n}, "robot": {"structure": "RR",
+                                                                                         "dh": "generic"}}
+        Collocation().build(problem_from_config(parse_config(cfg))).nlp.hessian("auto")
+        assert asked.pop() == expected
 
 
 BLOCK = """

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-COMPILE_MODES = ("none", "O0", "O1", "O2")
+from designopt.transcriptions.compiled import COMPILE_MODES
 
 
 @dataclass(frozen=True)
@@ -20,8 +20,9 @@ class SolverProfile:
     ``backend``: a name in `designopt.solve.backends.BACKENDS`. ``max_iter``: iteration cap. ``time_limit``:
     wall seconds per solve. ``warm``: the guess is a solution of a neighbouring problem (another sampling of
     the path, the same design held): start the barrier small and do not push the guess off its active bounds.
-    ``compile``: how the per-waypoint derivative blocks are evaluated (``none``: interpreted; ``O0``-``O2``:
-    C compiled at that level, cached on disk). ``observers``: names in `designopt.solve.observers.OBSERVERS`,
+    ``compile``: how the per-waypoint blocks are evaluated (``none``: interpreted; ``O0``-``O2``: C compiled at
+    that level, cached on disk; ``auto``: O1 for a block evaluated at 500 points or more, a long program's, and O0
+    below: `designopt.transcriptions.compiled.level`). ``observers``: names in `designopt.solve.observers.OBSERVERS`,
     watching every iteration; an observer may stop a solve, never change it.
     """
 
@@ -29,7 +30,7 @@ class SolverProfile:
     max_iter: int = 1000
     time_limit: float = 300.0
     warm: bool = False
-    compile: str = "O0"
+    compile: str = "auto"
     observers: tuple[str, ...] = ()
     options: tuple[tuple[str, float | int | str], ...] = ()
 

@@ -16,8 +16,21 @@ from pathlib import Path
 
 import casadi as ca
 
-COMPILE_MODES = ("none", "O0", "O1", "O2")
+COMPILE_MODES = ("none", "O0", "O1", "O2", "auto")
 GENERATOR = {"with_header": False}  # CasADi's code generator options (part of the cache key)
+# Mode ``auto``: a block evaluated at this many points or more per call is compiled at O1, any other at O0. At -O0
+# a cell's clearance Hessian block takes 3x as long per point as at -O1 (82 against 26 us, the pocket cell's PUMA)
+# and is most of an iteration on a long program, but gcc -O1 takes 35-60 s for it against 3 s: once per block and
+# machine (the cache), paid back within one solve from some 500 points (a program of 250 waypoints with a cell).
+AUTO_O1_FROM = 500
+
+
+def level(mode: str, points: int) -> str:
+    """The compile mode of one block function evaluated at ``points`` points per call under ``mode``: ``auto`` is
+    O1 from `AUTO_O1_FROM` points and O0 below; any other mode is itself."""
+    if mode != "auto":
+        return mode
+    return "O1" if points >= AUTO_O1_FROM else "O0"
 
 
 def cache_dir() -> Path:
@@ -27,7 +40,8 @@ def cache_dir() -> Path:
 
 
 def compiled(fn: ca.Function, mode: str = "O0") -> ca.Function:
-    """Return ``fn`` evaluated as compiled C (mode O0/O1/O2), or unchanged for mode ``none``.
+    """Return ``fn`` evaluated as compiled C (mode O0/O1/O2; ``auto`` is resolved by `level` first), or unchanged
+    for mode ``none``.
 
     Falls back to the interpreted function if no C compiler works, so a machine without gcc is slower,
     not broken.
@@ -42,8 +56,8 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
     warm build). Mode ``none``: ``derive()`` itself."""
     if mode == "none":
         return derive()
-    if mode not in COMPILE_MODES:
-        raise ValueError(f"compile must be one of {COMPILE_MODES}, got {mode!r}")
+    if mode not in COMPILE_MODES or mode == "auto":
+        raise ValueError(f"a block compiles at none, O0, O1 or O2 (auto is resolved by level), got {mode!r}")
     # Serialised graphs are deterministic across processes; hashing one is 4-6x cheaper than generating its C,
     # which is only needed when the library is missing (0.58 s of the pocket cell's warm build).
     key = hashlib.sha256(f"{identity}|{mode}|{ca.__version__}|{GENERATOR}".encode()).hexdigest()[:20]

@@ -16,7 +16,7 @@ import numpy as np
 
 from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
-from designopt.transcriptions.compiled import compiled
+from designopt.transcriptions.compiled import compiled, level
 from designopt.transcriptions.degeneracy import q_independent_rows
 from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function, block_symbols, per_point
 from designopt.transcriptions.jacobian import (
@@ -96,7 +96,8 @@ class NLP:
         if self.blocks is None:
             return None
         if compile_mode not in self._hessians:
-            groups = [(block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1], compile_mode),
+            groups = [(block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1],
+                                              level(compile_mode, len(b.y_index))),
                        b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
             self._hessians[compile_mode] = assemble_hessian(self.n_variables, self.n_constraints, groups,
                                                             self._constant_hessian)
@@ -108,7 +109,8 @@ class NLP:
         if self.blocks is None:
             return None
         if compile_mode not in self._jacobians:
-            groups = [(*block_jacobian_function(b.terms, compile_mode), b.y_index, self._inputs(b), b.mu_index)
+            groups = [(*block_jacobian_function(b.terms, level(compile_mode, len(b.y_index))), b.y_index,
+                       self._inputs(b), b.mu_index)
                       for b in self.blocks]
             self._jacobians[compile_mode] = assemble_jacobian(self.x, self.g, self.functions(compile_mode)[1],
                                                               groups)
@@ -124,7 +126,8 @@ class NLP:
                 self._values[compile_mode] = (ca.Function("nlp_f", [self.x], [self.f]),
                                               ca.Function("nlp_g", [self.x], [self.g]))
             else:
-                groups = [(*(None if fn is None else compiled(fn, compile_mode) for fn in split_terms(b.terms)),
+                groups = [(*(None if fn is None else compiled(fn, level(compile_mode, len(b.y_index)))
+                             for fn in split_terms(b.terms)),
                            b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
                 self._values[compile_mode] = assemble_values(self.x, self.g, groups, self.quadratic)
         return self._values[compile_mode]
@@ -136,7 +139,8 @@ class NLP:
         if self.blocks is None:
             return None
         if compile_mode not in self._gradients:
-            groups = [(block_gradient_function(b.terms, compile_mode), b.y_index, self._inputs(b)) for b in self.blocks]
+            groups = [(block_gradient_function(b.terms, level(compile_mode, len(b.y_index))), b.y_index,
+                       self._inputs(b)) for b in self.blocks]
             self._gradients[compile_mode] = assemble_gradient(self.n_variables, self.functions(compile_mode)[0],
                                                               groups + gradient_groups(self.quadratic))
         return self._gradients[compile_mode]
