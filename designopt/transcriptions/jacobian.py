@@ -32,6 +32,17 @@ def block_jacobian_function(terms: ca.Function, compile_mode: str) -> tuple[ca.F
     return compiled(fn, compile_mode), np.asarray(rows, int), np.asarray(cols, int)
 
 
+def unclaimed_rows(n_g: int, mu_indices: list[np.ndarray]) -> np.ndarray:
+    """The rows of g (of ``n_g``) in no block, given each block's ``mu_index`` (its rows in g); ValueError when two
+    blocks claim one row."""
+    claimed = np.zeros(n_g, dtype=bool)
+    for mu_index in mu_indices:
+        if np.any(claimed[mu_index.ravel()]):
+            raise ValueError("two blocks claim the same constraint row")
+        claimed[mu_index.ravel()] = True
+    return np.flatnonzero(~claimed)
+
+
 def assemble_jacobian(x, g, g_of: ca.Function,
                       groups: list[tuple[ca.Function, np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]]
                       ) -> ca.Function:
@@ -44,12 +55,9 @@ def assemble_jacobian(x, g, g_of: ca.Function,
     Rows of g in no group are differentiated from their own expressions.
     """
     n_x, n_g = x.shape[0], g.shape[0]
-    in_block = np.zeros(n_g, dtype=bool)
-    triplets = []
-    for _, rows, cols, y_index, _, mu_index in groups:
-        in_block[mu_index.ravel()] = True
-        triplets.append((mu_index[:, rows].ravel(), y_index[:, cols].ravel()))  # point by point, as map stacks them
-    rest = np.flatnonzero(~in_block)
+    triplets = [(mu_index[:, rows].ravel(), y_index[:, cols].ravel())  # point by point, as map stacks them
+                for _, rows, cols, y_index, _, mu_index in groups]
+    rest = unclaimed_rows(n_g, [mu_index for *_, mu_index in groups])
     J_rest = ca.jacobian(g[ca.DM(rest.tolist())] if rest.size else ca.SX(0, 1), x)
     r_rows, r_cols = (np.asarray(a, int) for a in J_rest.sparsity().get_triplet())
     triplets.append((rest[r_rows], r_cols))

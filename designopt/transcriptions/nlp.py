@@ -24,6 +24,7 @@ from designopt.transcriptions.jacobian import (
     assemble_jacobian,
     block_gradient_function,
     block_jacobian_function,
+    unclaimed_rows,
 )
 from designopt.transcriptions.quadratic import QuadraticTerm, constant_hessian, gradient_groups, total
 
@@ -86,6 +87,11 @@ class NLP:
         self._gradients: dict[str, object] = {}
         self._values: dict[str, tuple[ca.Function, ca.Function]] = {}
 
+    @staticmethod
+    def _level(block: BlockStructure, compile_mode: str) -> str:
+        """The compile mode of a block's functions under the profile's ``compile_mode`` (`compiled.level`)."""
+        return level(compile_mode, len(block.y_index))
+
     def _inputs(self, block: BlockStructure) -> list:
         """A block's constant inputs, one column per point (the toolpath's `waypoint_inputs` unless it has its own)."""
         return list(waypoint_inputs(self.problem.toolpath) if block.inputs is None else block.inputs)
@@ -97,7 +103,7 @@ class NLP:
             return None
         if compile_mode not in self._hessians:
             groups = [(block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1],
-                                              level(compile_mode, len(b.y_index))),
+                                              self._level(b, compile_mode)),
                        b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
             self._hessians[compile_mode] = assemble_hessian(self.n_variables, self.n_constraints, groups,
                                                             self._constant_hessian)
@@ -109,7 +115,7 @@ class NLP:
         if self.blocks is None:
             return None
         if compile_mode not in self._jacobians:
-            groups = [(*block_jacobian_function(b.terms, level(compile_mode, len(b.y_index))), b.y_index,
+            groups = [(*block_jacobian_function(b.terms, self._level(b, compile_mode)), b.y_index,
                        self._inputs(b), b.mu_index)
                       for b in self.blocks]
             self._jacobians[compile_mode] = assemble_jacobian(self.x, self.g, self.functions(compile_mode)[1],
@@ -126,7 +132,7 @@ class NLP:
                 self._values[compile_mode] = (ca.Function("nlp_f", [self.x], [self.f]),
                                               ca.Function("nlp_g", [self.x], [self.g]))
             else:
-                groups = [(*(None if fn is None else compiled(fn, level(compile_mode, len(b.y_index)))
+                groups = [(*(None if fn is None else compiled(fn, self._level(b, compile_mode))
                              for fn in split_terms(b.terms)),
                            b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
                 self._values[compile_mode] = assemble_values(self.x, self.g, groups, self.quadratic)
@@ -139,7 +145,7 @@ class NLP:
         if self.blocks is None:
             return None
         if compile_mode not in self._gradients:
-            groups = [(block_gradient_function(b.terms, level(compile_mode, len(b.y_index))), b.y_index,
+            groups = [(block_gradient_function(b.terms, self._level(b, compile_mode)), b.y_index,
                        self._inputs(b)) for b in self.blocks]
             self._gradients[compile_mode] = assemble_gradient(self.n_variables, self.functions(compile_mode)[0],
                                                               groups + gradient_groups(self.quadratic))
@@ -160,10 +166,9 @@ class NLP:
     def derivatives(self, compile_mode: str) -> tuple[dict, dict]:
         """(the NLP for nlpsol, the derivative functions for its options): with blocks, hess_lag, jac_g and
         grad_f are given and the NLP is f and g assembled from the blocks (`functions`), so that nlpsol derives
-        nothing itself
-        (it otherwise spends seconds on the SX graph of a cell problem: 6.5 s of the pocket cell's 7.3 s build,
-        benchmarks/speed_table.py); without blocks the SX NLP, for nlpsol to differentiate. Every piece is built
-        once per NLP and shared by the solvers of all its profiles."""
+        nothing itself (it otherwise spends seconds on the SX graph of a cell problem: 6.5 s of the pocket cell's
+        7.3 s build, benchmarks/speed_table.py); without blocks the SX NLP, for nlpsol to differentiate. Every piece
+        is built once per NLP and compile mode and shared by the solvers of all its profiles."""
         if self.blocks is None:
             return {"x": self.x, "f": self.f, "g": self.g}, {}
         return self._oracle(compile_mode), {"hess_lag": self.hessian(compile_mode),
@@ -202,12 +207,7 @@ def assemble_values(x, g, groups: list[tuple[ca.Function | None, ca.Function | N
         if c is not None and mu_index.size:
             values.append(ca.vec(c.map(y_index.shape[0])(at, *block_inputs)))  # point by point, as mu_index
             rows.append(mu_index.ravel())
-    in_block = np.zeros(n_g, dtype=bool)
-    for r in rows:
-        if np.any(in_block[r]):
-            raise ValueError("two blocks claim the same constraint row")
-        in_block[r] = True
-    rest = np.flatnonzero(~in_block)
+    rest = unclaimed_rows(n_g, rows)
     if rest.size:
         values.append(ca.Function("g_rest", [x], [g[ca.DM(rest.tolist())]])(X))
         rows.append(rest)
