@@ -105,18 +105,35 @@ def projected(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations
               tol: float = 1e-3) -> np.ndarray:
     """``Q`` (N x n_moving) moved onto the path with the design ``q_d`` held: at every waypoint a damped
     least-squares IK on the tracking residual (tool position in W [m], tool axis), within the joints' bounds,
-    from that waypoint's row of ``Q`` (so that it keeps its branch). A waypoint still further than ``tol`` from
-    its target then starts again from the waypoint before it, as a walk along the path does, and keeps the
-    better of the two. A waypoint's residual never grows."""
+    from that waypoint's row of ``Q`` (so that it keeps its branch). Then, from the first waypoint on, a
+    waypoint still further than ``tol`` from its target, or one that no trajectory within the velocity limits
+    reaches from the waypoint before it (`beyond_reach`: the IK or ``Q`` changed branch there), starts again
+    from the waypoint before it, as a walk along the path does. The walk is kept if it is nearer the target, or
+    if it is on it (within ``tol``) and within reach where the step was not (where the path itself asks for more
+    than the limits allow, the IK's own answer stays). A waypoint's residual never grows above its row's, or
+    above ``tol`` where the step was beyond reach."""
     Q = np.array(Q, dtype=float)
     everywhere = np.arange(len(Q))
     Q, r = _moved_onto_path(problem, q_d, Q, everywhere, iterations)
     for k in range(1, len(Q)):
-        if np.linalg.norm(r[k]) > tol:
+        jumped = bool(beyond_reach(problem, Q[k - 1 : k + 1], k - 1)[0])
+        if np.linalg.norm(r[k]) > tol or jumped:
             walked, r_walked = _moved_onto_path(problem, q_d, Q[k - 1 : k], everywhere[k : k + 1], iterations)
-            if r_walked[0] @ r_walked[0] < r[k] @ r[k]:
+            nearer = r_walked[0] @ r_walked[0] < r[k] @ r[k]
+            reached = np.linalg.norm(r_walked[0]) <= tol and not beyond_reach(problem, np.vstack([Q[k - 1], walked]),
+                                                                             k - 1)[0]
+            if nearer or (jumped and reached):
                 Q[k], r[k] = walked[0], r_walked[0]
     return Q
+
+
+def beyond_reach(problem: DesignProblem, Q: np.ndarray, first: int = 0) -> np.ndarray:
+    """For each step between rows of ``Q`` (waypoints ``first``, ``first + 1``, ...): is some joint's step
+    longer than its velocity limit allows in the time between them? No trajectory the collocation accepts makes
+    such a step: its cubic's velocities at both knots and at the midpoint are bounded, and the midpoint's is
+    3/2 dq/h - (v_0 + v_1)/4, so |dq| <= v_max h. (len(Q) - 1 booleans.)"""
+    h = problem.toolpath.h[first : first + len(Q) - 1, None]
+    return np.any(np.abs(np.diff(Q, axis=0)) > np.asarray(problem.velocity_limits, float)[None, :] * h, axis=1)
 
 
 def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks: np.ndarray, iterations: int):
