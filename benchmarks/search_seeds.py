@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -55,7 +56,8 @@ def main() -> None:
         for seed in range(args.first_seed, args.first_seed + args.seeds):
             cfg = json.loads(json.dumps(base))
             _set(cfg, "search.seed", seed)
-            path = config.parent / f".bench-seed{seed}.yaml"  # beside the original: relative files resolve
+            # beside the original (relative files resolve), named so that concurrent runs do not collide
+            path = config.parent / f".bench-{config.stem}-{os.getpid()}-seed{seed}.yaml"
             path.write_text(yaml.safe_dump(cfg))
             try:
                 t0 = time.perf_counter()
