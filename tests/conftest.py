@@ -13,7 +13,7 @@ from designopt.config import parse_config
 from designopt.problem import problem_from_config
 from designopt.solve import Seeded, SolverProfile, solve_guess, solve_one
 
-# The configs the project ships (not benchmarks/search_seeds.py's per-seed copies beside them, `.bench-seed*.yaml`)
+# The configs the project ships (not benchmarks/search_seeds.py's per-seed copies beside them, `.bench-*.yaml`)
 SHIPPED_CONFIGS = sorted(p for p in (Path(__file__).resolve().parent.parent / "configs").glob("*.yaml")
                          if not p.name.startswith("."))
 
