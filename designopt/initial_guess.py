@@ -129,11 +129,9 @@ def projected(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations
 
 def beyond_reach(problem: DesignProblem, Q: np.ndarray, first: int = 0) -> np.ndarray:
     """For each step between rows of ``Q`` (waypoints ``first``, ``first + 1``, ...): is some joint's step
-    longer than its velocity limit allows in the time between them? No trajectory the collocation accepts makes
-    such a step: its cubic's velocities at both knots and at the midpoint are bounded, and the midpoint's is
-    3/2 dq/h - (v_0 + v_1)/4, so |dq| <= v_max h. (len(Q) - 1 booleans.)"""
-    h = problem.toolpath.h[first : first + len(Q) - 1, None]
-    return np.any(np.abs(np.diff(Q, axis=0)) > np.asarray(problem.velocity_limits, float)[None, :] * h, axis=1)
+    longer than it can move in the time between them (`DesignProblem.max_steps`)? No trajectory the collocation
+    accepts makes such a step. (len(Q) - 1 booleans.)"""
+    return np.any(np.abs(np.diff(Q, axis=0)) > problem.max_steps[first : first + len(Q) - 1], axis=1)
 
 
 def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks: np.ndarray, iterations: int):

@@ -64,6 +64,13 @@ class DesignProblem:
         return np.broadcast_to(np.asarray(self.joint_velocity, dtype=float), (self.chain.n_moving,)).copy()
 
     @property
+    def max_steps(self) -> np.ndarray:
+        """The most each moving joint can move between neighbouring waypoints, v_max h ((N - 1) x n_moving; rad or
+        m). No trajectory the collocation accepts moves further: its cubic's velocities at both knots and at the
+        midpoint are bounded, and the midpoint's is 3/2 dq/h - (v_0 + v_1)/4."""
+        return self.toolpath.h[:, None] * self.velocity_limits[None, :]
+
+    @property
     def k_inv(self) -> np.ndarray:
         """Inverse stiffness of each moving joint, base to tool (rad/(N*m) or m/N)."""
         return 1.0 / self.stiffness.diagonal(self.chain.structure)

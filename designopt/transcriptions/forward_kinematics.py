@@ -89,7 +89,7 @@ class ForwardKinematicsNLP:
         cons.add(C, *free_untracked(problem, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)),
                                     tracking_rows(problem, "epsilon")))
         if scheme.continuous:
-            step = problem.velocity_limits[:, None] * np.tile(tp.h, (n_m, 1))
+            step = problem.max_steps.T
             cons.add(Q[:, 1:] - Q[:, :-1], -step, step)
 
         lo_m = [j.lower for j in chain.moving]
