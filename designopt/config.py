@@ -308,7 +308,7 @@ class SearchConfig(_Strict):
     """How the problem is searched (`designopt.solve.search`): a named preset, its seed, and optionally another
     number of starts or another spread of their designs (perturb, box)."""
 
-    preset: Literal["quick", "default", "thorough", "paper"] = "default"
+    preset: Literal["quick", "default", "thorough", "paper", "production"] = "default"
     seed: Annotated[int, Field(ge=0)] = 0
     starts: Annotated[int, Field(ge=1, le=100_000)] | None = None
     spread: Literal["perturb", "box"] | None = None
@@ -341,7 +341,7 @@ class CellConfig(_Strict):
 
 # Keys of an older shape: each names what replaced it (README "Config").
 MOVED = {
-    "solver": "replaced by search: {preset: quick | default | thorough | paper, seed, starts}",
+    "solver": "replaced by search: {preset: quick | default | thorough | paper | production, seed, starts}",
     "robot.design": "moved to design: the design joints of robot and placement in one list, e.g. "
                     "design: [d, a, alpha, placement]",
     "robot.design_origins": "moved to design: name the origin components there, e.g. [elbow_joint.origin.z]",

@@ -41,6 +41,7 @@ from designopt.solve import (
     run_search,
     run_task,
     solve_guess,
+    solve_one,
 )
 from designopt.solve.starts import Rebranched
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
@@ -67,6 +68,21 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
                               None, None, boxed, 2)
     assert task.start.spread == "box"
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, refine=2, seed=2, profile=PRESETS["quick"].profile)
+
+
+def test_a_profiles_options_reach_ipopt_and_the_production_preset_regularises():
+    """A profile's options reach IPOPT itself (a cap of 2 iterations given as an option stops a solve after 2), and
+    the production preset is the paper's multistart on 4 starts with IPOPT's constraint block regularised."""
+    problem = problem_from_config(parse_config({"toolpath": {"kind": "figure_eight", "waypoints": 6}}))
+    capped = replace(PRESETS["paper"].profile, options=(("ipopt.max_iter", 2),))
+    sol = solve_one(problem, profile=capped)
+    assert (sol.raw.status, sol.raw.iterations) == ("Maximum_Iterations_Exceeded", 2)
+    assert solve_one(problem, profile=PRESETS["paper"].profile).raw.iterations > 2
+    production = search_from_config(parse_config({"search": {"preset": "production"}}))
+    regularised = replace(PRESETS["paper"].profile, options=(("ipopt.perturb_always_cd", "yes"),))
+    assert production == replace(PRESETS["paper"], starts=4, profile=regularised)
+    assert "IPOPT options perturb_always_cd yes" in production.describe()
+    assert "IPOPT" not in PRESETS["default"].describe()
 
 
 def test_a_coarse_path_is_a_subset_of_the_task():

@@ -65,6 +65,8 @@ class Search:
     def describe(self) -> str:
         """The search in words."""
         held = "; a solve stalled on a degenerate design is finished held" if self.hold_degenerate else ""
+        options = ", ".join(f"{k.removeprefix('ipopt.')} {v}" for k, v in self.profile.options)
+        held += f"; IPOPT options {options}" if options else ""  # what the profile sets beyond the backend's own
         cap = f"<= {self.profile.max_iter} iterations"
         if self.strategy == "multistart":
             return f"multistart: {self.starts} seeded starts on the full path ({cap}){held}"
@@ -96,6 +98,12 @@ PRESETS: dict[str, Search] = {
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     # the paper's comparisons: every method gets the same seeded cold starts on the full path, start for start
     "paper": Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0)),
+    # an existing arm placed for a long program: few basins, so 4 cold starts on the full program, and IPOPT's
+    # constraint block regularised from the first iteration (an arm that passes a singular configuration on the way
+    # makes its position rows dependent; their multipliers grew to 1e13 on configs/gcode_pocket.yaml, 4 starts 39 ->
+    # 13 s; not in the default search, where it moved the answers both ways: docs/decisions.md, 2026-11-25)
+    "production": Search(strategy="multistart", starts=4, profile=SolverProfile(
+        max_iter=1500, time_limit=120.0, options=(("ipopt.perturb_always_cd", "yes"),))),
 }
 
 
