@@ -8,9 +8,9 @@ x, y, z, axis x, y, z; clearance at a knot or a midpoint; the floor); the larges
 waypoints involved, the smallest singular value of the tracking Jacobian d(p_W, z_x, z_y)/dq (the arm's own
 singularity). Multipliers of 1e10 and more on dependent rows are what IPOPT's inertia corrections fight.
 
-    .venv/bin/python benchmarks/degenerate_rows.py configs/gcode_pocket.yaml 2 --stop 70
-    .venv/bin/python benchmarks/degenerate_rows.py configs/gcode_pocket.yaml 2 --stop 40 \
-        --option ipopt.perturb_always_cd=yes
+    .venv/bin/python benchmarks/degenerate_rows.py configs/gcode_pocket.yaml 2 --stop 70 \
+        --option ipopt.perturb_always_cd=no      # without the production preset's regularisation
+    .venv/bin/python benchmarks/degenerate_rows.py configs/gcode_pocket.yaml 2 --stop 40    # with it
 """
 
 from __future__ import annotations
