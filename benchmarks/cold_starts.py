@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 from joblib import Parallel, delayed
+from solver_options import parse_options
 
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
@@ -55,7 +56,7 @@ def main() -> None:
     parser.add_argument("--option", action="append", default=[], help="a solver option KEY=VALUE, e.g. "
                         "ipopt.perturb_always_cd=no (added after the config's own)")
     args = parser.parse_args()
-    options = tuple((k, _value(v)) for k, v in (o.split("=", 1) for o in args.option))
+    options = parse_options(args.option)
     rows = solve_cold_starts(args.config, range(args.first, args.first + args.starts), args.jobs, not args.no_hold,
                              args.max_iter, options)
     for i, status, its, sec, cost, tracks, held in rows:
@@ -70,15 +71,6 @@ def main() -> None:
           f"{np.median(its):.0f} iterations median (max {its.max()}), {cap} of {len(rows)} at the cap, "
           f"{len(costs)} track, best {costs.min() if len(costs) else np.nan:.5g}, "
           f"median {np.median(costs) if len(costs) else np.nan:.5g}, held on {sum(bool(r[6]) for r in rows)}")
-
-
-def _value(text: str):
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text
 
 
 if __name__ == "__main__":

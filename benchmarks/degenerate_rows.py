@@ -24,6 +24,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import casadi as ca  # noqa: E402
 import numpy as np  # noqa: E402
+from solver_options import parse_options  # noqa: E402
 
 from designopt.config import load_config  # noqa: E402
 from designopt.experiments.adapters import search_from_config  # noqa: E402
@@ -34,14 +35,6 @@ from designopt.transcriptions import Collocation  # noqa: E402
 from designopt.transcriptions.degeneracy import tracking_jacobian  # noqa: E402
 
 TRACKING_ROWS = ("position x", "position y", "position z", "axis x", "axis y", "axis z")
-
-
-def option(text: str) -> tuple[str, float | str]:
-    key, value = text.split("=", 1)
-    try:
-        return key, float(value)
-    except ValueError:
-        return key, value
 
 
 def row_names(nlp) -> tuple[np.ndarray, np.ndarray]:
@@ -66,7 +59,7 @@ def main() -> None:
     cfg = load_config(args.config)
     problem, search = problem_from_config(cfg), search_from_config(cfg)
     profile = replace(search.profile, max_iter=args.stop,
-                      options=(*search.profile.options, *(option(o) for o in args.option)))
+                      options=(*search.profile.options, *parse_options(args.option)))
     built, solver, _ = local.prepared(problem, Collocation(), profile)
     nlp = built.nlp
     guess = initial_guess(problem, args.start, search.seed, search.perturbation, search.init)

@@ -28,8 +28,8 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 sys.path.insert(0, str(Path(__file__).parent))
-import yaml  # noqa: E402
 from iteration_split import FUNCTIONS, logged_solve  # noqa: E402
+from solver_options import parse_options  # noqa: E402
 
 from designopt.config import load_config  # noqa: E402
 from designopt.experiments.adapters import search_from_config  # noqa: E402
@@ -156,7 +156,7 @@ def main() -> None:
         print(f"{args.compare[0]} -> {args.compare[1]}")
         print_table(new, old)
         return
-    options = tuple((k, yaml.safe_load(v)) for k, v in (o.split("=", 1) for o in args.option))  # as search_seeds --set
+    options = parse_options(args.option)
     results = {name: measure(name, args.starts, options, args.compile) for name in (args.only or PROBLEMS)}
     if args.json:
         args.json.write_text(json.dumps(results, indent=1))

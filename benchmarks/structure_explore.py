@@ -22,6 +22,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
+from solver_options import parse_options
 
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
@@ -33,20 +34,10 @@ from designopt.solve.tasks import fan_out
 CAPPED = "Maximum_Iterations_Exceeded"
 
 
-def option_value(text: str):
-    """An option's value: an int or a float when it reads as one, else the string (IPOPT's yes / no stay strings)."""
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text
-
-
 def explore(config: Path, structures: list[str], seed: int, options: list[str], jobs: int) -> list[dict]:
     cfg = load_config(config)
     search = replace(search_from_config(cfg), seed=seed)
-    given = tuple((k, option_value(v)) for k, v in (o.split("=", 1) for o in options if o != "none"))
+    given = parse_options([o for o in options if o != "none"])
     own = () if "none" in options else search.profile.options
     search = replace(search, profile=replace(search.profile, options=(*own, *given)))
     tasks = []
