@@ -31,7 +31,7 @@ from designopt.solve.strategies import run_search
 from designopt.solve.tasks import fan_out
 
 sys.path.insert(0, str(Path(__file__).parent))
-from structure_explore import option_value  # noqa: E402
+from solver_options import option_value  # noqa: E402
 
 
 def variant(text: str) -> tuple[str, dict]:
