@@ -98,10 +98,11 @@ PRESETS: dict[str, Search] = {
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     # the paper's comparisons: every method gets the same seeded cold starts on the full path, start for start
     "paper": Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0)),
-    # an existing arm placed for a long program: few basins, so 4 cold starts on the full program, and IPOPT's
-    # constraint block regularised from the first iteration (an arm that passes a singular configuration on the way
-    # makes its position rows dependent; their multipliers grew to 1e13 on configs/gcode_pocket.yaml, 4 starts 39 ->
-    # 13 s; not in the default search, where it moved the answers both ways: docs/decisions.md, 2026-11-25)
+    # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
+    # and IPOPT's constraint block regularised from the first iteration (at a singular configuration the position
+    # rows go dependent; their multipliers grew to 1e13 on configs/gcode_pocket.yaml, 4 starts 39 -> 13 s; on the
+    # Button program 1.8x slower, a 0.70x better design; not in the default search, where it moved the answers both
+    # ways: docs/decisions.md, 2026-11-25)
     "production": Search(strategy="multistart", starts=4, profile=SolverProfile(
         max_iter=1500, time_limit=120.0, options=(("ipopt.perturb_always_cd", "yes"),))),
 }
