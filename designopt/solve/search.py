@@ -66,17 +66,17 @@ class Search:
         """The search in words."""
         held = "; a solve stalled on a degenerate design is finished held" if self.hold_degenerate else ""
         options = ", ".join(f"{k.removeprefix('ipopt.')} {v}" for k, v in self.profile.options)
-        held += f"; IPOPT options {options}" if options else ""  # what the profile sets beyond the backend's own
+        solver = f"; IPOPT options {options}" if options else ""  # what the profile sets beyond the backend's own
         cap = f"<= {self.profile.max_iter} iterations"
         if self.strategy == "multistart":
-            return f"multistart: {self.starts} seeded starts on the full path ({cap}){held}"
+            return f"multistart: {self.starts} seeded starts on the full path ({cap}){held}{solver}"
         screen = (f", the best {self.screen} distinct re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations, if the path has more)" if self.screen_waypoints else "")
         again = (f", the best {self.rebranch} distinct restarted {self.rebranch_starts} times each on a new joint "
                  f"branch" if self.rebranch else "")
         return (f"coarse to fine: {self.starts} starts on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations){again}{screen}, the best {self.refine} distinct optima refined "
-                f"on the full path ({cap}){held}")
+                f"on the full path ({cap}){held}{solver}")
 
 
 # IPOPT options for design spaces whose tracking Jacobian goes rank-deficient on the way: a structure with fewer
@@ -86,7 +86,11 @@ class Search:
 # step the multipliers to reduce the dual infeasibility. On the K = I sweep (seed 0): 1,473 instead of 2,113 of the
 # 5,040 exploration solves at the cap, 0.71x the solver CPU, 61 of 123 structure bests lower and 23 higher. On the
 # main job (six revolute joints, default search) they made the answer worse (docs/decisions.md, 2026-11-24).
-DEGENERATE_JACOBIAN = (("ipopt.perturb_always_cd", "yes"), ("ipopt.alpha_for_y", "min-dual-infeas"))
+REGULARISED_CONSTRAINTS = (("ipopt.perturb_always_cd", "yes"),)
+DEGENERATE_JACOBIAN = (*REGULARISED_CONSTRAINTS, ("ipopt.alpha_for_y", "min-dual-infeas"))
+
+# the paper's comparisons: every method gets the same seeded cold starts on the full path, start for start
+PAPER = Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0))
 
 PRESETS: dict[str, Search] = {
     # a structure sweep's per-structure search: half the default's starts and refinements, tighter caps, no second
@@ -96,15 +100,13 @@ PRESETS: dict[str, Search] = {
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     "default": Search(),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
-    # the paper's comparisons: every method gets the same seeded cold starts on the full path, start for start
-    "paper": Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0)),
+    "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
     # and IPOPT's constraint block regularised from the first iteration (at a singular configuration the position
     # rows go dependent; their multipliers grew to 1e13 on configs/gcode_pocket.yaml, 4 starts 39 -> 13 s; on the
     # Button program 1.8x slower, a 0.70x better design; not in the default search, where it moved the answers both
     # ways: docs/decisions.md, 2026-11-25)
-    "production": Search(strategy="multistart", starts=4, profile=SolverProfile(
-        max_iter=1500, time_limit=120.0, options=(("ipopt.perturb_always_cd", "yes"),))),
+    "production": replace(PAPER, starts=4, profile=replace(PAPER.profile, options=REGULARISED_CONSTRAINTS)),
 }
 
 
