@@ -103,9 +103,9 @@ PRESETS: dict[str, Search] = {
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
     # and IPOPT's constraint block regularised from the first iteration (at a singular configuration the position
-    # rows go dependent; their multipliers grew to 1e13 on configs/gcode_pocket.yaml, 4 starts 39 -> 13 s; on the
-    # Button program 1.8x slower, a 0.70x better design; not in the default search, where it moved the answers both
-    # ways: docs/decisions.md, 2026-11-25)
+    # rows go dependent; their multipliers grew to 1e13 on configs/gcode_pocket.yaml, 4 starts 39 -> 13 s). A per-job
+    # choice: on the Button program the PUMA took 1.8x as long for a 0.70x design and the Kinova did worse on every
+    # count; in the default search it moved the answers both ways (docs/decisions.md, 2026-11-25)
     "production": replace(PAPER, starts=4, profile=replace(PAPER.profile, options=REGULARISED_CONSTRAINTS)),
 }
 
