@@ -416,6 +416,58 @@ def test_a_bound_stops_a_feasible_solve_still_above_it_and_nothing_else():
         assert steps[-1] is expected and watch.stopped is expected
 
 
+def test_a_stalled_violation_stops_a_solve_and_a_falling_or_feasible_one_never():
+    from designopt.solve.observers import Iterate, StalledViolation
+
+    def stops_at(violations, patience=50):
+        """The iteration (observed every 5th) at which the watch stops a solve with these violations, or None."""
+        watch = StalledViolation(None, patience=patience)
+        for k, v in enumerate(violations, start=1):
+            if watch.observe(Iterate(np.zeros(2), 1.0, v), 5):
+                return 5 * k
+        return None
+
+    assert stops_at([0.3] * 40) == 5 + 50  # flat above 1 mm: the first look sets where it stands, 50 more stop it
+    assert stops_at([0.3 * 0.9**k for k in range(400)]) is None  # halves every 7 looks (35 iterations): never
+    assert stops_at([0.3] * 9 + [0.14] * 9 + [0.06] * 9 + [0.02] * 9) is None  # each pause shorter than patience
+    assert stops_at([5e-4] * 400) is None  # tracks (violation <= 1e-3): never, however long
+    assert stops_at([5e-4] * 20 + [0.3] * 40) == 5 * 20 + 50  # off the path again after 100, and stuck there
+    assert stops_at([0.3] * 9 + [0.2] * 40) == 5 + 50  # falling by less than half is not falling
+    assert stops_at([0.3] * 40, patience=100) == 5 + 100
+
+
+def test_a_cold_start_that_stalls_off_the_path_stops_with_its_status(milling_12, monkeypatch):
+    """The placement alone is designed, from 1.5 m away: IPOPT gets within 3-4 cm of the path, stays there and
+    declares the problem infeasible after ~200 iterations; the watch stops it once it has stalled for its patience,
+    having lost nothing (neither tracks)."""
+    from designopt.solve.observers import StalledViolation
+
+    cfg = copy.deepcopy(milling_12)
+    cfg["design"], cfg["placement"]["xyz"] = ["placement"], [1.5, 0.0, -0.2]
+    problem = problem_from_config(parse_config(cfg))
+    guess = initial_guess(problem, 0, 0, 0.3)
+    free = solve_guess(problem, Collocation(), SolverProfile(max_iter=1500), guess)
+    assert not free.metrics.tracks and free.raw.iterations > 150
+    monkeypatch.setattr(StalledViolation, "PATIENCE", 50)
+    watched = solve_guess(problem, Collocation(), SolverProfile(max_iter=1499, observers=("stalled_violation",)),
+                          guess)
+    assert watched.raw.status == "Stopped_On_Stalled_Violation" and not watched.metrics.tracks
+    assert 50 <= watched.raw.iterations < free.raw.iterations
+
+
+def test_multistart_watches_exact_tracking_starts_for_a_stalled_violation_and_nothing_else(milling_12):
+    from designopt.solve.strategies import multistart
+    from designopt.transcriptions.forward_kinematics import ForwardKinematics
+
+    problem = problem_from_config(parse_config(milling_12))
+    search = preset("paper", starts=2)
+    jobs = [Job("", problem), Job("", problem, ForwardKinematics())]
+    tasks = next(multistart.plan(jobs, search))
+    assert len(tasks) == 4
+    assert ["stalled_violation" in t.profile.observers for t in tasks] == [True, True, False, False]
+    assert all(t.profile.max_iter == 1500 and t.profile.options == search.profile.options for t in tasks)
+
+
 def test_a_solve_given_a_bound_stops_at_it_with_its_status(milling_12):
     from designopt.solve.observers import Bound
 

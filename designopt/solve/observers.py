@@ -94,7 +94,39 @@ class AboveBound:
         return self.stopped
 
 
-OBSERVERS = {"degenerate": DegenerateWatch, "above_bound": AboveBound}
+class StalledViolation:
+    """Stops a solve whose constraint violation has stopped falling: ``patience`` iterations in a row above ``tol``
+    (1 mm or mrad) without once falling below ``factor`` times where it stood when the run began. IPOPT declares a
+    problem locally infeasible only after its restoration phase fails too; a start that cannot track the path can
+    spend hundreds of iterations, or its time limit, getting there. A solve that only pauses is not stopped, and one
+    that tracks is never stopped.
+
+    ``PATIENCE``: of the cold full-path starts measured (`benchmarks/violation_traces.py`: the pocket cell, the
+    Kinova and the PUMA on the Button program, the main job), none that went on to track stalled for more than 75
+    iterations; the ones that stalled longer never tracked."""
+
+    status = "Stopped_On_Stalled_Violation"
+    PATIENCE = 150
+
+    def __init__(self, problem: DesignProblem | None = None, patience: int | None = None, tol: float = 1e-3,
+                 factor: float = 0.5):
+        self.patience = self.PATIENCE if patience is None else patience
+        self.tol, self.factor = tol, factor
+        self.reset()
+
+    def reset(self, bound: Bound | None = None) -> None:
+        self.anchor, self.run, self.stopped = float("inf"), 0, False
+
+    def observe(self, iterate: Iterate, iterations: int = 1) -> bool:
+        if iterate.violation <= self.tol or iterate.violation < self.factor * self.anchor:
+            self.anchor, self.run = max(iterate.violation, self.tol), 0
+        else:
+            self.run += iterations
+        self.stopped = self.run >= self.patience
+        return self.stopped
+
+
+OBSERVERS = {"degenerate": DegenerateWatch, "above_bound": AboveBound, "stalled_violation": StalledViolation}
 
 
 def make_observers(names, problem: DesignProblem) -> list:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, replace
 
 from designopt.problem import DesignProblem
 from designopt.solution import Solution
+from designopt.solve.observers import StalledViolation
 from designopt.solve.optima import best_solution
 from designopt.solve.profile import SolverProfile
 from designopt.solve.tasks import Task
@@ -69,7 +70,8 @@ class Search:
         solver = f"; IPOPT options {options}" if options else ""  # what the profile sets beyond the backend's own
         cap = f"<= {self.profile.max_iter} iterations"
         if self.strategy == "multistart":
-            return f"multistart: {self.starts} seeded starts on the full path ({cap}){held}{solver}"
+            stall = f"; a start no closer to the path for {StalledViolation.PATIENCE} iterations is stopped"
+            return f"multistart: {self.starts} seeded starts on the full path ({cap}){stall}{held}{solver}"
         screen = (f", the best {self.screen} distinct re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations, if the path has more)" if self.screen_waypoints else "")
         again = (f", the best {self.rebranch} distinct restarted {self.rebranch_starts} times each on a new joint "
