@@ -432,6 +432,11 @@ def test_a_stalled_violation_stops_a_solve_and_a_falling_or_feasible_one_never()
     assert stops_at([5e-4] * 20 + [0.3] * 40) == 5 * 20 + 50  # off the path again after 100, and stuck there
     assert stops_at([0.3] * 9 + [0.2] * 40) == 5 + 50  # falling by less than half is not falling
     assert stops_at([0.3] * 40, patience=100) == 5 + 100
+    # nearly back on the path (2 mm, the lowest yet), a step away, then on its way back (20 % a look, so halved
+    # within the patience however it is counted), never below half the lowest before its patience is up: not stopped
+    assert stops_at([0.3] * 2 + [2e-3] + [0.2] * 2 + [0.2 * 0.8**k for k in range(60)]) is None
+    assert stops_at([0.3] * 2 + [2e-3] + [0.2] * 30) == 5 * 3 + 50  # ... and when it stays away: stopped
+    assert stops_at([0.3, 0.2, 0.3, 0.25] * 10) == 5 + 50  # spikes that never halve it: stopped
 
 
 def test_a_cold_start_that_stalls_off_the_path_stops_with_its_status(milling_12, monkeypatch):

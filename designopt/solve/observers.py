@@ -9,6 +9,7 @@ continuation on another problem) is a strategy's business (`designopt.solve.stra
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,15 +96,16 @@ class AboveBound:
 
 
 class StalledViolation:
-    """Stops a solve whose constraint violation has stopped falling: ``patience`` iterations in a row above ``tol``
-    (1 mm or mrad) without once falling below ``factor`` times where it stood when the run began. IPOPT declares a
-    problem locally infeasible only after its restoration phase fails too; a start that cannot track the path can
-    spend hundreds of iterations, or its time limit, getting there. A solve that only pauses is not stopped, and one
-    that tracks is never stopped.
+    """Stops a solve whose constraint violation has stopped falling. Both must hold, on a solve above ``tol`` (1 mm or
+    mrad): for ``patience`` iterations in a row the violation has not fallen below ``factor`` times the lowest it had
+    reached before them, and it is now still at least ``factor`` times the largest violation of those iterations.
+    IPOPT declares a problem locally infeasible only after its restoration phase fails too; a start that cannot track
+    the path can spend hundreds of iterations, or its time limit, getting there. A solve that tracks is never
+    stopped, nor one that is making its way back to the path after a step away from it (the second condition), nor
+    one whose violation only spikes (the first).
 
-    ``PATIENCE``: of the cold full-path starts measured (`benchmarks/violation_traces.py`: the pocket cell, the
-    Kinova and the PUMA on the Button program, the main job), none that went on to track stalled for more than 75
-    iterations; the ones that stalled longer never tracked."""
+    ``PATIENCE``: chosen from the cold full-path starts of six jobs (`benchmarks/violation_traces.py`,
+    docs/benchmarks.md "Stalled starts")."""
 
     status = "Stopped_On_Stalled_Violation"
     PATIENCE = 150
@@ -116,13 +118,19 @@ class StalledViolation:
 
     def reset(self, bound: Bound | None = None) -> None:
         self.anchor, self.run, self.stopped = float("inf"), 0, False
+        self.window: deque[tuple[int, float]] = deque()  # (run, violation) of the looks in the current run
 
     def observe(self, iterate: Iterate, iterations: int = 1) -> bool:
-        if iterate.violation <= self.tol or iterate.violation < self.factor * self.anchor:
-            self.anchor, self.run = max(iterate.violation, self.tol), 0
+        v = iterate.violation
+        if v <= self.tol or v < self.factor * self.anchor:
+            self.anchor, self.run = max(v, self.tol), 0
+            self.window.clear()
         else:
             self.run += iterations
-        self.stopped = self.run >= self.patience
+        self.window.append((self.run, v))
+        while self.window[0][0] < self.run - self.patience:
+            self.window.popleft()
+        self.stopped = self.run >= self.patience and v >= self.factor * max(w for _, w in self.window)
         return self.stopped
 
 
