@@ -104,8 +104,8 @@ class StalledViolation:
     stopped, nor one that is making its way back to the path after a step away from it (the second condition), nor
     one whose violation only spikes (the first).
 
-    ``PATIENCE``: chosen from the cold full-path starts of six jobs (`benchmarks/violation_traces.py`,
-    docs/benchmarks.md "Stalled starts")."""
+    ``PATIENCE``: 2.5 times the longest stall of a start that went on to track, over the cold full-path starts of five
+    jobs and the explorations of three (`benchmarks/violation_traces.py`, docs/benchmarks.md "Stalled starts")."""
 
     status = "Stopped_On_Stalled_Violation"
     PATIENCE = 150

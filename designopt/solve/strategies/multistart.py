@@ -11,10 +11,11 @@ from designopt.solve.search import Searched, by_job
 from designopt.solve.strategies.steps import seeded_tasks
 
 STAGE = "start"
-# Only for transcriptions that track exactly (TO): their violation is the distance to the path. On the cold starts
-# measured (benchmarks/violation_traces.py: the pocket cell 16, the Kinova and the PUMA on the Button program 8 each,
-# the main job 16) no start that went on to track stalled for more than 75 iterations; the FK baseline, whose
-# starts were not measured, keeps IPOPT's own ending.
+# Only for transcriptions that track exactly (TO): their violation is the distance to the path. Of the cold starts
+# traced (benchmarks/violation_traces.py: the pocket cell 16, the Kinova and the PUMA on the Button program 8 each, the
+# main job 16, its placement-only case 8), none that went on to track would have been stopped with a patience above
+# 60 iterations (docs/benchmarks.md "Stalled starts"); the FK baseline, whose starts were not traced, keeps IPOPT's
+# own ending.
 STALLED = "stalled_violation"
 
 
