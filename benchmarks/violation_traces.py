@@ -5,7 +5,8 @@ and records, every 5th iteration, the largest constraint violation and the objec
 the profile's own). Writes the traces to ``--out`` (JSON); with ``--replay`` reads them back instead of solving.
 Then, for each ``--patience`` (iterations), it replays `designopt.solve.observers.StalledViolation` on every trace
 and prints what the rule would have stopped: starts, the iterations and seconds saved, and the stopped starts that
-went on to track (the rule's false stops):
+went on to track (the rule's false stops); before that, the longest stall of a start that tracked (the largest
+patience that would still have stopped one):
 
     .venv/bin/python benchmarks/violation_traces.py configs/gcode_pocket.yaml --starts 16 --out pocket.json
     .venv/bin/python benchmarks/violation_traces.py --replay pocket.json --patience 50 100 200
