@@ -97,8 +97,10 @@ class AboveBound:
 
 class StalledViolation:
     """Stops a solve whose constraint violation has stopped falling. Both must hold, on a solve above ``tol`` (1 mm or
-    mrad): for ``patience`` iterations in a row the violation has not fallen below ``factor`` times the lowest it had
-    reached before them, and it is now still at least ``factor`` times the largest violation of those iterations.
+    mrad): for ``patience`` iterations in a row the violation has not fallen below ``factor`` times the level it last
+    fell to (``anchor``: each time it falls below ``factor`` times the anchor, or to ``tol``, that is the new anchor
+    and the count starts again), and it is now still at least ``factor`` times the largest violation of those
+    iterations.
     IPOPT declares a problem locally infeasible only after its restoration phase fails too; a start that cannot track
     the path can spend hundreds of iterations, or its time limit, getting there. A solve that tracks is never
     stopped, nor one that is making its way back to the path after a step away from it (the second condition), nor
