@@ -70,7 +70,7 @@ class Search:
         solver = f"; IPOPT options {options}" if options else ""  # what the profile sets beyond the backend's own
         cap = f"<= {self.profile.max_iter} iterations"
         if self.strategy == "multistart":
-            stall = f"; a start no closer to the path for {StalledViolation.PATIENCE} iterations is stopped"
+            stall = f"; a TO start no closer to the path for {StalledViolation.PATIENCE} iterations is stopped"
             return f"multistart: {self.starts} seeded starts on the full path ({cap}){stall}{held}{solver}"
         screen = (f", the best {self.screen} distinct re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations, if the path has more)" if self.screen_waypoints else "")
