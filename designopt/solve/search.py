@@ -129,6 +129,12 @@ class Job:
     transcription: object = field(default_factory=Collocation)
 
     @property
+    def tracks_exactly(self) -> bool:
+        """Whether the transcription holds the tool on the path at every waypoint (TO): its constraint violation is
+        then the distance to the path, and a design can degenerate the way hard equalities do."""
+        return getattr(self.transcription, "exact_tracking", False)
+
+    @property
     def identity(self) -> tuple[str, str, str]:
         return self.case, self.transcription.name, self.problem.chain.structure
 

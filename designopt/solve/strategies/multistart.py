@@ -22,7 +22,7 @@ STALLED = "stalled_violation"
 def plan(jobs, search):
     tasks = []
     for job in jobs:
-        watched = search.profile.observing(STALLED) if getattr(job.transcription, "exact_tracking", False) else None
+        watched = search.profile.observing(STALLED) if job.tracks_exactly else None
         tasks += seeded_tasks(job, STAGE, job.problem, watched, search, search.starts)
     done = yield tasks
     return [Searched(job, [], final) for job, final in zip(jobs, by_job(jobs, done), strict=True)]

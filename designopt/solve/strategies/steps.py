@@ -13,7 +13,7 @@ def solve_setup(job: Job, search: Search, profile=None):
     designs, and the continuation that finishes such a solve, when the search holds them and the job's
     transcription tracks exactly."""
     profile = profile or search.profile
-    if search.hold_degenerate and getattr(job.transcription, "exact_tracking", False):
+    if search.hold_degenerate and job.tracks_exactly:
         return profile.observing(HoldDegenerate.observer), HoldDegenerate()
     return profile, None
 
