@@ -49,7 +49,8 @@ class Recorder:
 def trace_start(config: str, index: int, options: tuple, waypoints: int | None = None,
                 max_iter: int | None = None) -> dict:
     """One seeded start of ``config`` solved on its full path (or on ``waypoints`` of them, as the search's
-    exploration does) with a `Recorder` watching."""
+    exploration does) with a `Recorder` watching. The imports are the worker's own: a registry imported at module level
+    would reach the worker as a pickled copy, and the recorder would be registered in the copy."""
     from designopt.config import load_config
     from designopt.experiments.adapters import search_from_config
     from designopt.problem import problem_from_config
