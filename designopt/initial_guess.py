@@ -22,7 +22,7 @@ from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
 INIT_MODES = ("reach", "ik", "constant")
-SPREADS = ("perturb", "box")  # how seeded starts spread their designs (`initial_guess`)
+SPREADS = ("perturb", "box", "mixed")  # how seeded starts spread their designs (`initial_guess`)
 
 
 def perturbed_design(problem: DesignProblem, rng: np.random.Generator, scale: float) -> np.ndarray:
@@ -231,13 +231,15 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
     """Start ``index`` of a seeded multistart (seed * 1000 + index). Start 0 keeps the configured design; the
     others perturb it by ``scale`` (``spread`` perturb: first joints within +-pi/2) or draw it from the task's
     box (``spread`` box, `box_design`: first joints over the whole circle, so that folded postures are
-    reached); ``design`` (if given) is the start design instead. Each start depends only on (seed, index), so
-    starts can be made in any order."""
+    reached); ``spread`` mixed: odd starts as box, even ones as perturb. ``design`` (if given) is the start design
+    instead. Each start depends only on (seed, index), so starts can be made in any order."""
     if mode not in INIT_MODES:
         raise ValueError(f"init must be one of {INIT_MODES}, got {mode!r}")
     if spread not in SPREADS:
         raise ValueError(f"spread must be one of {SPREADS}, got {spread!r}")
     rng = np.random.default_rng([seed, index])
+    if spread == "mixed":
+        spread = "box" if index % 2 else "perturb"
     if design is not None:
         q_d = within_bounds(problem, design)
     elif index == 0:

@@ -313,7 +313,8 @@ def test_a_box_start_draws_the_design_from_the_tasks_size_and_the_joints_from_th
     """``spread`` box (`box_design`): lengths in [0, b] with b half the path's largest extent (0.3 m for the
     main job's 0.6 m figure-eight), the placement's position within +-b of the configured one, angles over the
     circle; the first joints of revolute joints over [-pi, pi] (perturb: [-pi/2, pi/2]); start 0 keeps the
-    configured design either way."""
+    configured design either way; ``spread`` mixed makes each odd start the box's and each even one the
+    perturbation's."""
     from designopt.initial_guess import box_design, initial_guess, random_configuration
 
     problem = problem_from_config(parse_config({"toolpath": {"kind": "figure_eight", "waypoints": 10}}))
@@ -341,5 +342,10 @@ def test_a_box_start_draws_the_design_from_the_tasks_size_and_the_joints_from_th
     box = initial_guess(problem, 5, 3, 0.3, "constant", spread="box")
     np.testing.assert_array_equal(box.q_d, initial_guess(problem, 5, 3, 0.3, "constant", spread="box").q_d)
     assert not np.allclose(box.q_d, initial_guess(problem, 5, 3, 0.3, "constant").q_d)
+    for index in range(1, 7):  # mixed: odd starts are the box's own, even ones the perturbation's, design and joints
+        mixed = initial_guess(problem, index, 3, 0.3, "constant", spread="mixed")
+        alike = initial_guess(problem, index, 3, 0.3, "constant", spread="box" if index % 2 else "perturb")
+        np.testing.assert_array_equal(mixed.q_d, alike.q_d)
+        np.testing.assert_array_equal(mixed.Q, alike.Q)
     with pytest.raises(ValueError, match="spread"):
         initial_guess(problem, 1, 0, 0.3, spread="sphere")

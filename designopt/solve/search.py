@@ -24,8 +24,8 @@ from designopt.transcriptions import Collocation
 class Search:
     """A strategy and its budget. Counts are per problem; iteration caps per solve.
 
-    ``starts`` seeded starts (from ``seed``; designs by ``spread``: perturbed by ``perturbation`` or drawn from the
-    task's box, `designopt.initial_guess`; joints by ``init``): cold starts on
+    ``starts`` seeded starts (from ``seed``; designs by ``spread``: perturbed by ``perturbation``, drawn from the
+    task's box, or mixed, odd starts from the box, `designopt.initial_guess`; joints by ``init``): cold starts on
     the full path for ``multistart``; for ``coarse_to_fine`` the exploration's starts on ``explore_waypoints`` of
     the path's waypoints (each capped at ``explore_max_iter``), then the ``rebranch`` best distinct of their optima
     each started again ``starts // rebranch`` times (at least once) on a new joint branch (the optimum's design,

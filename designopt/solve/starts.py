@@ -21,7 +21,7 @@ from designopt.transcriptions.base import InitialGuess
 class Seeded:
     """Start ``index`` of a seeded multistart (`designopt.initial_guess`): index 0 keeps the configured design, the
     others perturb it by ``scale`` (x 0.5 m for lengths, x pi for angles) or draw it from the task's box (``spread``
-    box), or ``design`` is the start design;
+    box; mixed: odd starts from the box, even ones perturbed), or ``design`` is the start design;
     joints by IK along the path (``init``). Depends only on (seed, index): starts can be made in any order."""
 
     seed: int
