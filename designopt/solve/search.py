@@ -69,14 +69,16 @@ class Search:
         options = ", ".join(f"{k.removeprefix('ipopt.')} {v}" for k, v in self.profile.options)
         solver = f"; IPOPT options {options}" if options else ""  # what the profile sets beyond the backend's own
         cap = f"<= {self.profile.max_iter} iterations"
+        drawn = {"perturb": "", "box": " drawn from the task's box",
+                 "mixed": " (every other one drawn from the task's box)"}[self.spread]
         if self.strategy == "multistart":
             stall = f"; a TO start no closer to the path for {StalledViolation.PATIENCE} iterations is stopped"
-            return f"multistart: {self.starts} seeded starts on the full path ({cap}){stall}{held}{solver}"
+            return f"multistart: {self.starts} seeded starts{drawn} on the full path ({cap}){stall}{held}{solver}"
         screen = (f", the best {self.screen} distinct re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations, if the path has more)" if self.screen_waypoints else "")
         again = (f", the best {self.rebranch} distinct restarted {self.rebranch_starts} times each on a new joint "
                  f"branch" if self.rebranch else "")
-        return (f"coarse to fine: {self.starts} starts on {self.explore_waypoints} waypoints (<= "
+        return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations){again}{screen}, the best {self.refine} distinct optima refined "
                 f"on the full path ({cap}){held}{solver}")
 
