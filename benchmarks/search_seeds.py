@@ -61,11 +61,13 @@ def main() -> None:
             path.write_text(yaml.safe_dump(cfg))
             try:
                 t0 = time.perf_counter()
-                subprocess.run([sys.executable, "-m", "cli.main", "run", str(path), "--out", tmp, "--name", f"s{seed}",
-                                "--no-figures"], cwd=ROOT, check=True, capture_output=True)
+                done = subprocess.run([sys.executable, "-m", "cli.main", "run", str(path), "--out", tmp, "--name",
+                                       f"s{seed}", "--no-figures"], cwd=ROOT, capture_output=True, text=True)
                 wall = time.perf_counter() - t0
             finally:
                 path.unlink()
+            if done.returncode != 0:  # e.g. 2: the run exists in --out already (say --out elsewhere)
+                sys.exit(f"seed {seed}: designopt run exited {done.returncode}: {done.stderr.strip()}")
             best = json.loads((Path(tmp) / cfg["name"] / f"s{seed}" / "best.json").read_text())["metrics"]
             cost = best["design_cost"]
             ratios.append(cost / known if known else cost)
