@@ -4,7 +4,8 @@
 
 Each argument is the table.csv of one `designopt sweep-structures` run (one search seed); prints the best 6-DOF
 cost per number of prismatic joints, the best structure per number of joints, the best 3R3P and PPPRRR against
-it, PPP's rank among 3-DOF structures, and the spread (max/min) between runs.
+it, how many 3R3P are within 2 % of the
+best, PPP's rank among 3-DOF structures, and the spread (max/min) between runs.
 """
 
 from __future__ import annotations
@@ -30,13 +31,15 @@ def main(paths: list[str]) -> None:
     print("|---" * (len(tables) + 2) + "|")
     for k in range(7):
         line(f"best 6-DOF, {k} P", [float(t[(t.dof == 6) & (t.n_prismatic == k)].design_cost.min()) for t in tables])
-    for d in (3, 4, 5, 6):
+    for d in (2, 3, 4, 5, 6):
         line(f"best {d}-DOF", [float(t[t.dof == d].design_cost.min()) for t in tables])
         line(f"best {d}-DOF structure", [t.loc[t[t.dof == d].design_cost.idxmin()].structure for t in tables])
     three = [t[(t.dof == 6) & (t.n_prismatic == 3)].sort_values("design_cost") for t in tables]
     line("best 3R3P", [f"{r.iloc[0].structure} {fmt(float(r.iloc[0].design_cost))}" for r in three])
     line("PPPRRR / best 3R3P", [float(r[r.structure == "PPPRRR"].design_cost.min() / r.iloc[0].design_cost)
                                 for r in three])
+    line("3R3P within 2 % of the best 3R3P", [int((r.design_cost <= 1.02 * r.iloc[0].design_cost).sum())
+                                              for r in three])
     line("PPP rank among 3-DOF", [list(t[t.dof == 3].sort_values("design_cost").structure).index("PPP") + 1
                                   for t in tables])
     line("structures that track", [len(t) for t in tables])
