@@ -15,6 +15,7 @@ The NLP is built once per problem shape and solved by any backend from any numbe
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 
@@ -28,6 +29,7 @@ from designopt.transcriptions.nlp import (
     NLP,
     BlockStructure,
     ConstraintList,
+    Deferred,
     clearance_terms,
     floor_terms,
     free_untracked,
@@ -122,7 +124,8 @@ class CollocationNLP:
         S, F, K_w = waypoint_inputs(tp)
 
         terms, c_lo, c_hi = waypoint_terms(problem, scheme.tracking, position_in_terms=not differential)
-        Phi, C = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F, K_w)
+        # the terms' graph over all waypoints: built only if the whole f or g is asked for, never for a solve
+        waypoint_graph = functools.cache(lambda: terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F, K_w))
 
         Q0, V0, Q1, V1 = Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:]
         Q_mid, V_mid = hermite_midpoint(Q0, V0, Q1, V1, h)
@@ -133,17 +136,17 @@ class CollocationNLP:
                      quadratic_terms.smoothness(problem, q_index, q_index + n_m,
                                                 np.full(N - 1, tp.dt) if tp.uniform else tp.h),
                      quadratic_terms.joint_regularization(problem, q_index, tp.weights))
-        objective = ca.sum2(Phi) + quadratic_terms.total(quadratic, x)
+        objective = Deferred(lambda: ca.sum2(waypoint_graph()[0]) + quadratic_terms.total(quadratic, x), 1)
 
         cons = ConstraintList()
-        n_c = C.shape[0]
+        n_c = terms.size1_out(1)
         C_lo, C_hi = np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N))
         once = once_only_rows(problem, scheme.tracking) if not differential else np.zeros(0, dtype=int)
         others = np.arange(N) != int(np.argmax(tp.is_tracked))  # held at the first tracked waypoint only
         C_lo[np.ix_(once, others)], C_hi[np.ix_(once, others)] = -np.inf, np.inf
         C_lo, C_hi = free_untracked(problem, C_lo, C_hi,
                                     tracking_rows(problem, scheme.tracking, position_in_terms=not differential))
-        cons.add(C, C_lo, C_hi)  # first, so that its multipliers are 0 .. n_c N
+        cons.add(Deferred(lambda: waypoint_graph()[1], n_c * N), C_lo, C_hi)  # first: multipliers 0 .. n_c N
 
         if differential:
             P = Z[2 * n_m :, :]
@@ -160,7 +163,8 @@ class CollocationNLP:
                 cons.add(P - S, -bound, bound)
             else:
                 weight = ca.DM((tp.weights * tracked)[None, :])
-                objective += problem.tracking_weight * ca.sum2(weight * ca.sum1((P - S) ** 2))
+                penalty, rest = problem.tracking_weight * ca.sum2(weight * ca.sum1((P - S) ** 2)), objective
+                objective = Deferred(lambda: rest.value + penalty, 1)
             self._drift = ca.Function("drift", [x], [ca.mmax(ca.sqrt(ca.sum1((P - p_W) ** 2)))])
 
         lo_m = np.array([j.lower for j in chain.moving])
@@ -177,7 +181,9 @@ class CollocationNLP:
             for points, at, count in ((Q, y_indices(n_d, n_m, N, self.n_state), N),
                                       (M, np.hstack([mid_index, np.tile(np.arange(n_d), (N - 1, 1))]), N - 1)):
                 first = cons.size
-                cons.add(clear.map(count)(ca.vertcat(points, ca.repmat(q_d, 1, count)))[1], 0.0, np.inf)
+                cons.add(Deferred(lambda points=points, count=count:
+                                  clear.map(count)(ca.vertcat(points, ca.repmat(q_d, 1, count)))[1], count * n_cl),
+                         0.0, np.inf)
                 cell_blocks.append(BlockStructure(clear, at, first + np.arange(count * n_cl).reshape(count, n_cl), ()))
             floor = floor_terms(problem)
             first = cons.size

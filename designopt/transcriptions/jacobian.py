@@ -14,6 +14,8 @@ of a reverse sweep of the whole graph.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import casadi as ca
 import numpy as np
 
@@ -43,22 +45,23 @@ def unclaimed_rows(n_g: int, mu_indices: list[np.ndarray]) -> np.ndarray:
     return np.flatnonzero(~claimed)
 
 
-def assemble_jacobian(x, g, g_of: ca.Function,
+def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: ca.Function,
                       groups: list[tuple[ca.Function, np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]]
                       ) -> ca.Function:
     """jac_g(x, p) -> (g, dg/dx), for nlpsol's ``jac_g`` option.
 
-    ``x``, ``g``: the NLP's SX decision vector and constraints; ``g_of``: x -> g as a function. Each group is
+    ``x``: the NLP's SX decision vector; ``n_g`` its number of constraints and ``g_rows`` (row indices -> SX) their
+    own expressions (only the rows in no group are asked for); ``g_of``: x -> g as a function. Each group is
     (block, rows, cols, y_index, block_inputs, mu_index) with ``block``, ``rows``, ``cols`` from
     `block_jacobian_function`, ``y_index`` (N x n_y) the position in x of each block variable, ``mu_index``
     (N x n_c) the position in g of each block row and ``block_inputs`` the block's constant extra inputs (mapped).
     Rows of g in no group are differentiated from their own expressions.
     """
-    n_x, n_g = x.shape[0], g.shape[0]
+    n_x = x.shape[0]
     triplets = [(mu_index[:, rows].ravel(), y_index[:, cols].ravel())  # point by point, as map stacks them
                 for _, rows, cols, y_index, _, mu_index in groups]
     rest = unclaimed_rows(n_g, [mu_index for *_, mu_index in groups])
-    J_rest = ca.jacobian(g[ca.DM(rest.tolist())] if rest.size else ca.SX(0, 1), x)
+    J_rest = ca.jacobian(g_rows(rest) if rest.size else ca.SX(0, 1), x)
     r_rows, r_cols = (np.asarray(a, int) for a in J_rest.sparsity().get_triplet())
     triplets.append((rest[r_rows], r_cols))
     all_rows = np.concatenate([t[0] for t in triplets])

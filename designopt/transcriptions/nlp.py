@@ -9,6 +9,7 @@ backend (`designopt.solve.backends`) to solve.
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import casadi as ca
@@ -29,26 +30,67 @@ from designopt.transcriptions.jacobian import (
 from designopt.transcriptions.quadratic import QuadraticTerm, constant_hessian, gradient_groups, total
 
 
+@dataclass(frozen=True)
+class Deferred:
+    """An expression built only when asked for (`value`, once): the per-point terms' graph inlined over all points
+    (e.g. ``terms.map(N)`` called on SX), which a solve never needs -- its values and derivatives come from the
+    blocks -- and which took 70 % of a 1,208-waypoint program's build. ``rows``: its number of entries."""
+
+    build: Callable[[], ca.SX]
+    rows: int
+
+    @functools.cached_property
+    def value(self) -> ca.SX:
+        """The expression as a column, built on first use."""
+        expr = ca.vec(self.build())
+        if expr.shape[0] != self.rows:
+            raise ValueError(f"a deferred expression has {expr.shape[0]} rows, declared {self.rows}")
+        return expr
+
+
 @dataclass
 class ConstraintList:
-    """Constraints and their bounds, stacked in the order added (CasADi's column-major vec)."""
+    """Constraints and their bounds, stacked in the order added (CasADi's column-major vec); an entry may be
+    `Deferred`."""
 
     def __post_init__(self):
         self.g, self.lo, self.hi = [], [], []
 
     def add(self, expr, lo, hi) -> None:
-        expr = ca.vec(expr)
+        expr = expr if isinstance(expr, Deferred) else ca.vec(expr)
+        rows = expr.rows if isinstance(expr, Deferred) else expr.shape[0]
         self.g.append(expr)
-        self.lo.append(np.broadcast_to(np.ravel(lo, order="F"), expr.shape[0]))
-        self.hi.append(np.broadcast_to(np.ravel(hi, order="F"), expr.shape[0]))
+        self.lo.append(np.broadcast_to(np.ravel(lo, order="F"), rows))
+        self.hi.append(np.broadcast_to(np.ravel(hi, order="F"), rows))
 
     @property
     def size(self) -> int:
         """Rows so far: the lam_g index of the next row added."""
-        return sum(g.shape[0] for g in self.g)
+        return sum(len(lo) for lo in self.lo)
+
+    def rows(self, index: np.ndarray):
+        """The rows ``index`` of g as one SX column, building only the deferred entries they fall in."""
+        index = np.asarray(index, dtype=int)
+        starts = np.cumsum([0, *(len(lo) for lo in self.lo)])
+        parts, taken = [], []
+        for k, expr in enumerate(self.g):
+            inside = index[(index >= starts[k]) & (index < starts[k + 1])]
+            if inside.size:
+                expr = expr.value if isinstance(expr, Deferred) else expr
+                parts.append(expr[ca.DM((inside - starts[k]).tolist())])
+                taken.append(inside)
+        if not parts:
+            return ca.SX(0, 1)
+        where = {int(row): i for i, row in enumerate(np.concatenate(taken))}
+        return ca.vertcat(*parts)[ca.DM([where[int(row)] for row in index])]
 
     def stacked(self):
-        return ca.vertcat(*self.g), np.concatenate(self.lo), np.concatenate(self.hi)
+        """(g, lower bounds, upper bounds), every deferred entry built."""
+        return (ca.vertcat(*(e.value if isinstance(e, Deferred) else e for e in self.g)),
+                np.concatenate(self.lo), np.concatenate(self.hi))
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.concatenate(self.lo), np.concatenate(self.hi)
 
 
 @dataclass(frozen=True)
@@ -75,10 +117,10 @@ class NLP:
                  constraints: ConstraintList,
                  lbx, ubx, blocks: list[BlockStructure] | None):
         self.problem, self.name = problem, name
-        self.x, self.f = x, objective
-        self.g, self.lbg, self.ubg = constraints.stacked()
+        self.x, self._objective, self.constraints = x, objective, constraints
+        self.lbg, self.ubg = constraints.bounds()
         self.lbx, self.ubx = np.asarray(lbx, float), np.asarray(ubx, float)
-        self.n_variables, self.n_constraints = x.shape[0], self.g.shape[0]
+        self.n_variables, self.n_constraints = x.shape[0], constraints.size
         self.n_equalities = int(np.sum(self.lbg == self.ubg))
         self.n_design = problem.chain.n_design
         self.blocks, self.quadratic = blocks, quadratic
@@ -86,6 +128,17 @@ class NLP:
         self._jacobians: dict[str, object] = {}
         self._gradients: dict[str, object] = {}
         self._values: dict[str, tuple[ca.Function, ca.Function]] = {}
+
+    @functools.cached_property
+    def f(self) -> ca.SX:
+        """The objective as one SX expression of ``x`` (built on first use: with blocks, a solve does not need it)."""
+        return self._objective.value if isinstance(self._objective, Deferred) else self._objective
+
+    @functools.cached_property
+    def g(self) -> ca.SX:
+        """The constraints as one SX column of ``x`` (built on first use: with blocks, a solve needs only the rows
+        in no block, `ConstraintList.rows`)."""
+        return self.constraints.stacked()[0]
 
     @staticmethod
     def _level(block: BlockStructure, compile_mode: str) -> str:
@@ -118,8 +171,8 @@ class NLP:
             groups = [(*block_jacobian_function(b.terms, self._level(b, compile_mode)), b.y_index,
                        self._inputs(b), b.mu_index)
                       for b in self.blocks]
-            self._jacobians[compile_mode] = assemble_jacobian(self.x, self.g, self.functions(compile_mode)[1],
-                                                              groups)
+            self._jacobians[compile_mode] = assemble_jacobian(self.x, self.n_constraints, self.constraints.rows,
+                                                              self.functions(compile_mode)[1], groups)
         return self._jacobians[compile_mode]
 
     def functions(self, compile_mode: str) -> tuple[ca.Function, ca.Function]:
@@ -135,7 +188,8 @@ class NLP:
                 groups = [(*(None if fn is None else compiled(fn, self._level(b, compile_mode))
                              for fn in split_terms(b.terms)),
                            b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
-                self._values[compile_mode] = assemble_values(self.x, self.g, groups, self.quadratic)
+                self._values[compile_mode] = assemble_values(self.x, self.n_constraints, self.constraints.rows,
+                                                             groups, self.quadratic)
         return self._values[compile_mode]
 
     def gradient(self, compile_mode: str):
@@ -186,18 +240,20 @@ def split_terms(terms: ca.Function) -> tuple[ca.Function | None, ca.Function | N
             ca.Function(f"{terms.name()}_c", [y, *params], [c]) if c.numel() else None)
 
 
-def assemble_values(x, g, groups: list[tuple[ca.Function | None, ca.Function | None, np.ndarray, list, np.ndarray]],
+def assemble_values(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX],
+                    groups: list[tuple[ca.Function | None, ca.Function | None, np.ndarray, list, np.ndarray]],
                     quadratic: tuple[QuadraticTerm, ...]) -> tuple[ca.Function, ca.Function]:
     """(x -> f, x -> g) of an NLP whose nonlinear terms sit in per-point blocks, as MX functions.
 
-    ``x``, ``g``: the NLP's SX decision vector and constraints (the rows in no block are taken from ``g``'s own,
-    small expressions). Each group is (phi, c, y_index, block_inputs, mu_index): a block's (y, *inputs) -> phi and
-    (y, *inputs) -> c (`split_terms`; None: none), ``y_index`` (N x n_y) the position in x of each block variable,
-    ``block_inputs`` its constant extra inputs (mapped) and ``mu_index`` (N x n_c) the position in g of each row
-    of c. f = the blocks' phi summed over their points + the ``quadratic`` terms; every row of g comes from
-    exactly one block or from ``g``.
+    ``x``: the NLP's SX decision vector; ``n_g`` its number of constraints and ``g_rows`` (row indices -> SX) their
+    own expressions, of which only the rows in no block are asked for (small ones, e.g. the collocation's). Each
+    group is (phi, c, y_index, block_inputs, mu_index): a block's (y, *inputs) -> phi and (y, *inputs) -> c
+    (`split_terms`; None: none), ``y_index`` (N x n_y) the position in x of each block variable, ``block_inputs``
+    its constant extra inputs (mapped) and ``mu_index`` (N x n_c) the position in g of each row of c. f = the
+    blocks' phi summed over their points + the ``quadratic`` terms; every row of g comes from exactly one block
+    or from ``g_rows``.
     """
-    n_x, n_g = x.shape[0], g.shape[0]
+    n_x = x.shape[0]
     X = ca.MX.sym("x", n_x)
     f, values, rows = total(quadratic, X), [], []
     for phi, c, y_index, block_inputs, mu_index in groups:
@@ -209,7 +265,7 @@ def assemble_values(x, g, groups: list[tuple[ca.Function | None, ca.Function | N
             rows.append(mu_index.ravel())
     rest = unclaimed_rows(n_g, rows)
     if rest.size:
-        values.append(ca.Function("g_rest", [x], [g[ca.DM(rest.tolist())]])(X))
+        values.append(ca.Function("g_rest", [x], [g_rows(rest)])(X))
         rows.append(rest)
     position = np.empty(n_g, dtype=int)
     position[np.concatenate([*rows, np.zeros(0, int)])] = np.arange(n_g)
