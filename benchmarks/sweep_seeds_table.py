@@ -16,7 +16,7 @@ import pandas as pd
 
 
 def fmt(x) -> str:
-    return f"{x:.3g}" if isinstance(x, float) else str(x)
+    return f"{x:.4g}" if isinstance(x, float) else str(x)
 
 
 def line(name: str, values: list) -> None:
