@@ -11,6 +11,8 @@ best, PPP's rank among 3-DOF structures, and the spread (max/min) between runs.
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 import pandas as pd
 
@@ -25,6 +27,9 @@ def line(name: str, values: list) -> None:
 
 
 def main(paths: list[str]) -> None:
+    missing = [p for p in paths if not Path(p).is_file()]
+    if missing:
+        sys.exit(f"error: {missing[0]}: no such file (the table.csv of a sweep run)")
     tables = [pd.read_csv(p) for p in paths]
     tables = [t[t.design_cost.notna()] for t in tables]
     print("| | " + " | ".join(f"seed {i}" for i in range(len(tables))) + " | spread (max/min) |")
