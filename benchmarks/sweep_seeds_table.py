@@ -29,7 +29,8 @@ def line(name: str, values: list) -> None:
 def main(paths: list[str]) -> None:
     missing = [p for p in paths if not Path(p).is_file()]
     if missing:
-        sys.exit(f"error: {missing[0]}: no such file (the table.csv of a sweep run)")
+        print(f"error: {missing[0]}: no such file (the table.csv of a sweep run)", file=sys.stderr)
+        sys.exit(2)
     tables = [pd.read_csv(p) for p in paths]
     tables = [t[t.design_cost.notna()] for t in tables]
     print("| | " + " | ".join(f"seed {i}" for i in range(len(tables))) + " | spread (max/min) |")
