@@ -15,7 +15,6 @@ The NLP is built once per problem shape and solved by any backend from any numbe
 
 from __future__ import annotations
 
-import functools
 import time
 from dataclasses import dataclass
 
@@ -31,6 +30,7 @@ from designopt.transcriptions.nlp import (
     ConstraintList,
     Deferred,
     clearance_terms,
+    deferred_terms,
     floor_terms,
     free_untracked,
     once_only_rows,
@@ -124,8 +124,6 @@ class CollocationNLP:
         S, F, K_w = waypoint_inputs(tp)
 
         terms, c_lo, c_hi = waypoint_terms(problem, scheme.tracking, position_in_terms=not differential)
-        # the terms' graph over all waypoints: built only if the whole f or g is asked for, never for a solve
-        waypoint_graph = functools.cache(lambda: terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), S, F, K_w))
 
         Q0, V0, Q1, V1 = Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:]
         Q_mid, V_mid = hermite_midpoint(Q0, V0, Q1, V1, h)
@@ -136,7 +134,8 @@ class CollocationNLP:
                      quadratic_terms.smoothness(problem, q_index, q_index + n_m,
                                                 np.full(N - 1, tp.dt) if tp.uniform else tp.h),
                      quadratic_terms.joint_regularization(problem, q_index, tp.weights))
-        objective = Deferred(lambda: ca.sum2(waypoint_graph()[0]) + quadratic_terms.total(quadratic, x), 1)
+        # the terms' graph over all waypoints: built only if the whole f or g is asked for, never for a solve
+        objective, C = deferred_terms(terms, ca.vertcat(Q, ca.repmat(q_d, 1, N)), (S, F, K_w), quadratic, x)
 
         cons = ConstraintList()
         n_c = terms.size1_out(1)
@@ -146,7 +145,7 @@ class CollocationNLP:
         C_lo[np.ix_(once, others)], C_hi[np.ix_(once, others)] = -np.inf, np.inf
         C_lo, C_hi = free_untracked(problem, C_lo, C_hi,
                                     tracking_rows(problem, scheme.tracking, position_in_terms=not differential))
-        cons.add(Deferred(lambda: waypoint_graph()[1], n_c * N), C_lo, C_hi)  # first: multipliers 0 .. n_c N
+        cons.add(C, C_lo, C_hi)  # first, so that its multipliers are 0 .. n_c N
 
         if differential:
             P = Z[2 * n_m :, :]

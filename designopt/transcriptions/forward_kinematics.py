@@ -12,7 +12,6 @@ position error <= position_tol and axis error <= position_tol <= axis_tol).
 
 from __future__ import annotations
 
-import functools
 import time
 from dataclasses import dataclass
 
@@ -26,7 +25,7 @@ from designopt.transcriptions.nlp import (
     NLP,
     BlockStructure,
     ConstraintList,
-    Deferred,
+    deferred_terms,
     free_untracked,
     tracking_rows,
     waypoint_inputs,
@@ -80,18 +79,15 @@ class ForwardKinematicsNLP:
         Q = ca.SX.sym("Q", n_m, N)
         x = ca.vertcat(q_d, ca.vec(Q))
         terms, c_lo, c_hi = waypoint_terms(problem, "epsilon", epsilon=self.epsilon)
-        # the terms' graph over all waypoints: built only if the whole f or g is asked for, never for a solve
-        waypoint_graph = functools.cache(lambda: terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)),
-                                                              *waypoint_inputs(tp)))
         q_index = n_d + np.arange(N)[:, None] * n_m + np.arange(n_m)[None, :]
         quadratic = (quadratic_terms.joint_regularization(problem, q_index, tp.weights),
                      *quadratic_terms.design_costs(problem, np.arange(n_d)))
-        objective = Deferred(lambda: ca.sum2(waypoint_graph()[0]) + quadratic_terms.total(quadratic, x), 1)
+        # the terms' graph over all waypoints: built only if the whole f or g is asked for, never for a solve
+        objective, C = deferred_terms(terms, ca.vertcat(Q, ca.repmat(q_d, 1, N)), waypoint_inputs(tp), quadratic, x)
 
         cons = ConstraintList()
         n_c = terms.size1_out(1)
-        cons.add(Deferred(lambda: waypoint_graph()[1], n_c * N),
-                 *free_untracked(problem, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)),
+        cons.add(C, *free_untracked(problem, np.tile(c_lo[:, None], (1, N)), np.tile(c_hi[:, None], (1, N)),
                                  tracking_rows(problem, "epsilon")))
         if scheme.continuous:
             step = problem.max_steps.T

@@ -48,6 +48,23 @@ class Deferred:
         return expr
 
 
+def deferred_terms(terms: ca.Function, y, inputs: tuple, quadratic: tuple[QuadraticTerm, ...], x
+                   ) -> tuple[Deferred, Deferred]:
+    """(objective, constraints) of per-point ``terms`` (y, *inputs) -> (phi, c) at the points ``y`` (one column per
+    point), both `Deferred`: the objective is the points' phi summed plus the ``quadratic`` terms at ``x``, the
+    constraints every point's c, point by point. The terms' graph over all points is built once, when either is
+    first asked for."""
+    n = y.shape[1]
+    graph = functools.cache(lambda: terms.map(n)(y, *inputs))
+    return (Deferred(lambda: ca.sum2(graph()[0]) + total(quadratic, x), 1),
+            Deferred(lambda: graph()[1], terms.size1_out(1) * n))
+
+
+def _built(expr):
+    """An entry of a `ConstraintList` as SX: a `Deferred` one built."""
+    return expr.value if isinstance(expr, Deferred) else expr
+
+
 @dataclass
 class ConstraintList:
     """Constraints and their bounds, stacked in the order added (CasADi's column-major vec); an entry may be
@@ -76,8 +93,7 @@ class ConstraintList:
         for k, expr in enumerate(self.g):
             inside = index[(index >= starts[k]) & (index < starts[k + 1])]
             if inside.size:
-                expr = expr.value if isinstance(expr, Deferred) else expr
-                parts.append(expr[ca.DM((inside - starts[k]).tolist())])
+                parts.append(_built(expr)[ca.DM((inside - starts[k]).tolist())])
                 taken.append(inside)
         if not parts:
             return ca.SX(0, 1)
@@ -86,8 +102,7 @@ class ConstraintList:
 
     def stacked(self):
         """(g, lower bounds, upper bounds), every deferred entry built."""
-        return (ca.vertcat(*(e.value if isinstance(e, Deferred) else e for e in self.g)),
-                np.concatenate(self.lo), np.concatenate(self.hi))
+        return (ca.vertcat(*(_built(e) for e in self.g)), *self.bounds())
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         return np.concatenate(self.lo), np.concatenate(self.hi)
@@ -132,7 +147,7 @@ class NLP:
     @functools.cached_property
     def f(self) -> ca.SX:
         """The objective as one SX expression of ``x`` (built on first use: with blocks, a solve does not need it)."""
-        return self._objective.value if isinstance(self._objective, Deferred) else self._objective
+        return _built(self._objective)
 
     @functools.cached_property
     def g(self) -> ca.SX:
