@@ -4,7 +4,9 @@ One independent joint vector q_k per waypoint plus the design joints; minimise t
 (+ regularisation) subject to L_t(t_k) <= epsilon at every waypoint. Nothing ties q_k to q_{k+1}, so a
 solution may jump between inverse-kinematics branches -- which no real trajectory can do; every result
 reports max_joint_step. ``continuous=True`` is the fair variant `fk_continuous`: |q_{k+1} - q_k| is bounded
-by the joint velocity limit TO uses, times the waypoint spacing.
+by the joint velocity limit TO uses, times the waypoint spacing. It is a relaxation of TO: TO's exact tracking
+meets L_t <= epsilon, and TO's velocity bounds at both knots and the midpoint of a cubic imply the step bound
+(the step is h (v_0 + 4 v_mid + v_1) / 6), so its best design can be below TO's (docs/results.md, C1).
 
 epsilon defaults to (0.95 position_tol)^2, so an FK solution tracks within the same tolerances as TO (its
 position error <= position_tol and axis error <= position_tol <= axis_tol).
