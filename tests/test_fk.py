@@ -44,3 +44,29 @@ def test_transcription_names():
     assert transcription_named("to").name == "to"
     with pytest.raises(ValueError):
         transcription_named("pso")
+
+
+def test_a_to_solution_is_feasible_for_fk_continuous():
+    """fk_continuous is a relaxation of TO (docs/results.md, C1): a TO solution's knots meet FK's tracking within
+    epsilon and its step bound, since TO's velocity bounds at both knots and the midpoint bound the step
+    h (v_0 + 4 v_mid + v_1) / 6. Checked where the velocity limit binds: some TO step is near v_max h."""
+    import casadi as ca
+
+    from designopt.transcriptions import Collocation
+    from designopt.transcriptions.base import InitialGuess
+
+    cfg = parse_config({"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 16},
+                        "robot": {"joint_velocity": 4.0}, "placement": {"xyz": [0.45, 0.0, -0.2]}})
+    problem = problem_from_config(cfg)
+    to = solve_from(problem, initial_guesses(problem, 1, 0, 0.3, "ik")[0], Collocation(), max_iter=500)
+    assert to.raw.success and to.metrics.tracks
+    bound = 4.0 / (problem.toolpath.n - 1)
+    assert to.metrics.max_joint_step >= 0.9 * bound  # the velocity limit shapes the TO trajectory
+
+    fk = ForwardKinematics(continuous=True).build(problem)
+    x = fk.pack(InitialGuess(q_d=to.raw.q_d, Q=to.raw.Q, V=to.raw.V, seed=0))
+    nlp = fk.nlp
+    g = np.asarray(ca.Function("g", [nlp.x], [nlp.g])(x)).ravel()
+    slack = 1e-9
+    assert np.all(g >= nlp.lbg - slack) and np.all(g <= nlp.ubg + slack)
+    assert np.all(x >= nlp.lbx - slack) and np.all(x <= nlp.ubx + slack)
