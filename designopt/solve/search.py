@@ -98,8 +98,10 @@ PAPER = Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1
 
 PRESETS: dict[str, Search] = {
     # a structure sweep's per-structure search: half the default's starts and refinements, tighter caps, no second
-    # round on new joint branches (not yet measured on the sweep, whose exploration it would double), and IPOPT
-    # set for degenerate Jacobians (most of a sweep's structures have fewer than six joints or prismatic ones)
+    # round on new joint branches (on the K = I sweep it took 1.5x the wall, moved the structure bests both ways and
+    # reached 5 instead of 8 of 10 references: its extra coarse optima crowd out, of the 2 refined, the ones that
+    # lift well; docs/decisions.md), and IPOPT set for degenerate Jacobians (most of a sweep's structures have fewer
+    # than six joints or prismatic ones)
     "quick": Search(starts=40, rebranch=0, refine=2,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     "default": Search(),
