@@ -78,12 +78,16 @@ def measure(name: str, starts: int, options: tuple = (), compile_mode: str | Non
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for start in range(starts):
-            _, solver, outcome, total, corrected, _ = logged_solve(problem, search, start, Path(tmp) / f"{start}.log")
+            built, solver, outcome, total, corrected, _ = logged_solve(problem, search, start,
+                                                                       Path(tmp) / f"{start}.log")
             stats = solver.solver.stats()
             functions = sum(stats.get(f"t_proc_{f}", 0.0) for f in FUNCTIONS)
             rows.append({"status": outcome.status, "iterations": outcome.iterations, "cpu_s": total,
                          "functions_s": functions, "corrected": corrected, "cost": outcome.objective})
-    return {"build_cold_s": cold, "build_warm_s": warm, "starts": rows}
+    # ``auto`` compiles a block tiered: -O1 when the compile cache already has it (a block solved with long enough),
+    # else -O0 -- the table says which ran (pin it with --compile O0 or O1)
+    tiered = "O0" if built.nlp.tiered_libraries(search.profile.compile) else "O1 or fixed"
+    return {"build_cold_s": cold, "build_warm_s": warm, "starts": rows, "tiered_level": tiered}
 
 
 def summary(m: dict) -> dict:
@@ -103,6 +107,7 @@ def summary(m: dict) -> dict:
 
 def print_table(results: dict, other: dict | None = None) -> None:
     names = list(results)
+    print("tiered blocks ran at: " + ", ".join(f"{n} {results[n].get('tiered_level', '?')}" for n in names))
     keys = list(summary(results[names[0]]))
     head = "| what | " + " | ".join(names) + " |"
     print(head)

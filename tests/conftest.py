@@ -4,6 +4,7 @@ solve one of them."""
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +13,11 @@ import pytest
 from designopt.config import parse_config
 from designopt.problem import problem_from_config
 from designopt.solve import Seeded, SolverProfile, solve_guess, solve_one
+
+# No background -O1 builds of hot blocks while the suite runs (and in the CLI processes it starts): which blocks
+# would cross the threshold depends on the machine's speed, and the builds would take the cores the tests time
+# nothing on. tests/test_tiered_compile.py turns tiering on where it tests it.
+os.environ["DESIGNOPT_TIER_UP_AFTER"] = "never"
 
 # The configs the project ships (not benchmarks/search_seeds.py's per-seed copies beside them, `.bench-*.yaml`)
 SHIPPED_CONFIGS = sorted(p for p in (Path(__file__).resolve().parent.parent / "configs").glob("*.yaml")

@@ -141,18 +141,19 @@ def test_compiled_block_gives_the_same_hessian(rng, tmp_path, monkeypatch):
 
 def test_auto_compiles_blocks_of_long_paths_at_o1(monkeypatch):
     """``auto`` (the profile's default) compiles a block evaluated at AUTO_O1_FROM points or more at O1 and one
-    at fewer points at O0; any other mode is itself, and a block is never compiled at "auto"."""
+    at fewer points tiered (O0, then O1 once solved with long enough); any other mode is itself, and a block is
+    never compiled at "auto"."""
     import designopt.transcriptions.hessian as hessian_module
 
-    assert level("auto", AUTO_O1_FROM) == "O1" and level("auto", AUTO_O1_FROM - 1) == "O0"
+    assert level("auto", AUTO_O1_FROM) == "O1" and level("auto", AUTO_O1_FROM - 1) == "tiered"
     assert level("none", 10**6) == "none" and level("O2", 1) == "O2" and SolverProfile().compile == "auto"
     x = ca.SX.sym("x")
     with pytest.raises(ValueError, match="auto"):
         compiled(ca.Function("f", [x], [x**2]), "auto")
     asked = []
-    monkeypatch.setattr(hessian_module, "compiled_as", lambda name, identity, derive, mode: asked.append(mode) or
-                        derive())
-    for n, expected in ((AUTO_O1_FROM, "O1"), (12, "O0")):
+    monkeypatch.setattr(hessian_module, "compiled_as",
+                        lambda name, identity, derive, mode, used: asked.append(mode) or derive())
+    for n, expected in ((AUTO_O1_FROM, "O1"), (12, "tiered")):
         cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": n}, "robot": {"structure": "RR",
                                                                                          "dh": "generic"}}
         Collocation().build(problem_from_config(parse_config(cfg))).nlp.hessian("auto")

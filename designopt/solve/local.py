@@ -19,6 +19,7 @@ from designopt.solve.backends import backend_named
 from designopt.solve.observers import Bound
 from designopt.solve.profile import SolverProfile
 from designopt.transcriptions.base import InitialGuess, RawResult
+from designopt.transcriptions.compiled import record_work
 
 # IPOPT's linear algebra gains nothing from threads at this size; parallelism is across starts.
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -50,9 +51,11 @@ def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
 def solve_guess(problem: DesignProblem, transcription, profile: SolverProfile, guess: InitialGuess,
                 bound: Bound | None = None) -> Solution:
     """Solve the problem from ``guess`` (held to ``bound`` if the profile observes "above_bound").
-    A solve that fails is a solution with its status, not an exception."""
+    A solve that fails is a solution with its status, not an exception. Its seconds count towards the tier-up of
+    the NLP's compiled blocks (`designopt.transcriptions.compiled`)."""
     built, solver, spent = prepared(problem, transcription, profile)
     outcome = solver.solve(built.pack(guess), bound)
+    record_work(built.nlp.tiered_libraries(profile.compile), outcome.solve_time_s)  # -O1 once paid for
     q_d, trajectory, drift = built.unpack(outcome.x)
     raw = RawResult(q_d=q_d, trajectory=trajectory, status=outcome.status, success=outcome.success,
                     iterations=outcome.iterations, solve_time_s=outcome.solve_time_s, build_time_s=spent,

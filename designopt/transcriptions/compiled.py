@@ -3,34 +3,69 @@
 Only per-waypoint functions are compiled (a few thousand lines of C, seconds); compiling a whole NLP
 takes minutes. The cache lives in ``$DESIGNOPT_CACHE`` or ``~/.cache/designopt`` and is safe to share
 between processes: each library is written under a temporary name and renamed into place.
+
+Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block is first
+compiled at gcc -O0 (about 1 s for the main job's Hessian block) and used so; every solve that used it adds its
+seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the same C source is
+compiled again at -O1 in a background process at the lowest priority (about 10 s for that block), which later
+builds, in any process, load instead. Every library is compiled with ``-ffp-contract=off`` (and never with
+-ffast-math), so -O0 and -O1 compute the same IEEE operations in the same order: a solve is the same to the last
+bit at either level, only faster at -O1 (the main job's default search: 0.79x the CPU, docs/benchmarks.md).
 """
 
 from __future__ import annotations
 
+import gzip
 import hashlib
 import os
+import shlex
 import subprocess
 import tempfile
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import casadi as ca
 
 COMPILE_MODES = ("none", "O0", "O1", "O2", "auto")
 GENERATOR = {"with_header": False}  # CasADi's code generator options (part of the cache key)
+# gcc's flags besides the level (part of the cache key): no fused multiply-adds, so that every level rounds alike
+FLAGS = ("-fPIC", "-shared", "-ffp-contract=off")
 # Mode ``auto``: a block evaluated at this many points or more per call is compiled at O1, any other at O0. At -O0
 # a cell's clearance Hessian block takes 3x as long per point as at -O1 (82 against 26 us, the pocket cell's PUMA)
 # and is most of an iteration on a long program, but gcc -O1 takes 35-60 s for it against 3 s: once per block and
 # machine (the cache), paid back within one solve from some 500 points (a program of 250 waypoints with a cell).
+# Below it, ``tiered``: O0 first, O1 once the block has been solved with long enough to pay for it (module doc).
 AUTO_O1_FROM = 500
+# Seconds of solves with a tiered block after which its -O1 build starts: the solving whose -O0 penalty (about a
+# sixth of it on the main job) adds up to what gcc -O1 takes for the main job's blocks (about 10 s) -- the
+# ski-rental rule, which never costs more than twice what knowing the future would. A sweep's structure is solved
+# for about 15 s and never tiers up; a task run again and again does from its second run.
+# `DESIGNOPT_TIER_UP_AFTER` (seconds, or ``never``) overrides it.
+TIER_UP_AFTER = 60.0
+STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
 
 
 def level(mode: str, points: int) -> str:
-    """The compile mode of one block function evaluated at ``points`` points per call under ``mode``: ``auto`` is
-    O1 from `AUTO_O1_FROM` points and O0 below; any other mode is itself."""
+    """The compile level of one block function evaluated at ``points`` points per call under ``mode``: ``auto`` is
+    O1 from `AUTO_O1_FROM` points and ``tiered`` below; any other mode is itself."""
     if mode != "auto":
         return mode
-    return "O1" if points >= AUTO_O1_FROM else "O0"
+    return "O1" if points >= AUTO_O1_FROM else "tiered"
+
+
+def tier_up_after() -> float | None:
+    """Seconds of solves after which a tiered library is built at -O1 (`TIER_UP_AFTER`, or the environment's
+    ``DESIGNOPT_TIER_UP_AFTER``); None: never."""
+    text = os.environ.get("DESIGNOPT_TIER_UP_AFTER", "").strip().lower()
+    if not text:
+        return TIER_UP_AFTER
+    if text == "never":
+        return None
+    try:
+        return max(float(text), 0.0)
+    except ValueError:
+        return TIER_UP_AFTER
 
 
 def cache_dir() -> Path:
@@ -39,36 +74,141 @@ def cache_dir() -> Path:
     return path
 
 
-def compiled(fn: ca.Function, mode: str = "O0") -> ca.Function:
-    """Return ``fn`` evaluated as compiled C (mode O0/O1/O2; ``auto`` is resolved by `level` first), or unchanged
-    for mode ``none``.
+def compiled(fn: ca.Function, mode: str = "O0", used: list[Path] | None = None) -> ca.Function:
+    """Return ``fn`` evaluated as compiled C (level O0/O1/O2/tiered; ``auto`` is resolved by `level` first), or
+    unchanged for mode ``none``. ``used``: see `compiled_as`.
 
     Falls back to the interpreted function if no C compiler works, so a machine without gcc is slower,
     not broken.
     """
-    return compiled_as(fn.name(), fn.serialize(), lambda: fn, mode)
+    return compiled_as(fn.name(), fn.serialize(), lambda: fn, mode, used)
 
 
-def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mode: str = "O0") -> ca.Function:
+def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mode: str = "O0",
+                used: list[Path] | None = None) -> ca.Function:
     """The function ``derive()`` (named ``name``) as compiled C, found in the cache by ``identity`` -- any text
     that determines the function, e.g. its serialised graph, or the small graph it is derived from and how --
     so that a function found there is never derived (its symbolic derivation and serialisation are most of a
-    warm build). Mode ``none``: ``derive()`` itself."""
+    warm build). Mode ``none``: ``derive()`` itself. Level ``tiered``: the -O1 library if the cache has it, else
+    the -O0 one (its C source kept beside it for the tier-up), whose path is appended to ``used`` so that the
+    solves that use it can be counted (`record_work`)."""
     if mode == "none":
         return derive()
-    if mode not in COMPILE_MODES or mode == "auto":
-        raise ValueError(f"a block compiles at none, O0, O1 or O2 (auto is resolved by level), got {mode!r}")
+    if mode not in ("O0", "O1", "O2", "tiered"):
+        raise ValueError(f"a block compiles at none, O0, O1, O2 or tiered (auto is resolved by level), got {mode!r}")
     # Serialised graphs are deterministic across processes; hashing one is 4-6x cheaper than generating its C,
     # which is only needed when the library is missing (0.58 s of the pocket cell's warm build).
-    key = hashlib.sha256(f"{identity}|{mode}|{ca.__version__}|{GENERATOR}".encode()).hexdigest()[:20]
-    library = cache_dir() / f"{name}_{key}.so"
+    key = hashlib.sha256(f"{identity}|{ca.__version__}|{GENERATOR}|{FLAGS}".encode()).hexdigest()[:20]
+    stem = cache_dir() / f"{name}_{key}"
+    tiered = mode == "tiered"
+    if tiered and library_at(stem, "O1").exists():
+        return ca.external(name, str(library_at(stem, "O1")))
+    mode = "O0" if tiered else mode
+    library = library_at(stem, mode)
     if not library.exists():
         fn = derive()
         try:
-            _build(_source(fn), library, mode)
+            source = _source(fn)
+            _build(source, library, mode)
         except (OSError, subprocess.CalledProcessError):
             return fn
+        if mode == "O0":  # kept for a tier-up (a tenth of the library's size)
+            _write_atomically(source_of(stem), gzip.compress(source.encode(), compresslevel=1))
+    if tiered and used is not None and source_of(stem).exists():
+        used.append(library)
     return ca.external(name, str(library))
+
+
+def library_at(stem: Path, mode: str) -> Path:
+    """The cache's library of ``stem`` (``<cache>/<name>_<key>``) compiled at level ``mode``."""
+    return stem.with_name(f"{stem.name}.{mode}.so")
+
+
+def source_of(stem: Path) -> Path:
+    """The gzipped C source kept beside a tiered library, for its -O1 build."""
+    return stem.with_name(f"{stem.name}.c.gz")
+
+
+def _stem(library: Path) -> Path:
+    return library.with_name(library.name.split(".", 1)[0])
+
+
+def record_work(libraries: Iterable[Path], seconds: float, background: bool = True) -> list[Path]:
+    """Count ``seconds`` of solving towards the tier-up of each tiered -O0 library in ``libraries`` (paths that
+    `compiled_as` appended to its ``used``), and start the -O1 build of each whose count has reached
+    `tier_up_after` (in a detached background process at the lowest priority unless ``background`` is false;
+    one process builds it, others find its lock). Returns the libraries whose -O1 build this call started."""
+    after = tier_up_after()
+    started = []
+    for library in dict.fromkeys(libraries):  # once each, in order
+        stem = _stem(library)
+        if after is None or library_at(stem, "O1").exists():
+            continue
+        record = stem.with_name(f"{stem.name}.work")
+        with open(record, "a") as fh:  # one short line per solve: appends from several processes do not mix
+            fh.write(f"{seconds:.3f}\n")
+        total = sum(float(v) for v in record.read_text().split() if _is_number(v))
+        if total >= after and tier_up(stem, background):
+            started.append(library)
+    return started
+
+
+def tier_up(stem: Path, background: bool = True) -> bool:
+    """Build ``stem``'s kept C source at -O1 into its -O1 library (atomically: under a temporary name, then
+    renamed), in a detached background process, or here when ``background`` is false. False when there is no
+    source, or another process holds the build's lock. A build that fails keeps its lock, so that it is tried
+    again only once the lock is stale (`STALE_LOCK_S`), not after every solve."""
+    source, target = source_of(stem), library_at(stem, "O1")
+    lock = target.with_name(f"{target.name}.lock")
+    if not source.exists() or not _take(lock):
+        return False
+    tmp = target.with_name(f"{target.name}.{os.getpid()}.tmp")
+    c_file = tmp.with_name(f"{tmp.name}.c")
+    q = shlex.quote
+    try:
+        c_file.write_bytes(gzip.decompress(source.read_bytes()))
+        compiler, c, out = q(os.environ.get("CC", "gcc")), q(str(c_file)), q(str(tmp))
+        build = (f"{compiler} -O1 {' '.join(FLAGS)} {c} -o {out} -lm && mv -f {out} {q(str(target))} && "
+                 f"rm -f {q(str(lock))}; rm -f {out} {c}")
+        # in the background the shell returns at once and the build, orphaned, outlives this process
+        command = f"({build}) >/dev/null 2>&1" + (" &" if background else "")
+        subprocess.run(["sh", "-c", command], check=False, stdin=subprocess.DEVNULL)
+    except (OSError, EOFError, gzip.BadGzipFile):
+        c_file.unlink(missing_ok=True)
+        lock.unlink(missing_ok=True)
+        return False
+    return True
+
+
+def _take(lock: Path) -> bool:
+    """Create ``lock`` if no other process holds it (a lock older than `STALE_LOCK_S` is taken over)."""
+    for _ in range(2):
+        try:
+            os.close(os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+            return True
+        except FileExistsError:
+            try:
+                if time.time() - lock.stat().st_mtime < STALE_LOCK_S:
+                    return False
+                lock.unlink()
+            except FileNotFoundError:
+                pass
+    return False
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
+
+
+def _write_atomically(path: Path, data: bytes) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name)
+    with os.fdopen(fd, "wb") as fh:
+        fh.write(data)
+    os.replace(tmp, path)
 
 
 def _source(fn: ca.Function) -> str:
@@ -86,7 +226,7 @@ def _build(source: str, library: Path, mode: str) -> None:
         tmp_lib = Path(tmp) / library.name
         compiler = os.environ.get("CC", "gcc")
         subprocess.run(
-            [compiler, f"-{mode}", "-fPIC", "-shared", str(c_file), "-o", str(tmp_lib), "-lm"],
+            [compiler, f"-{mode}", *FLAGS, str(c_file), "-o", str(tmp_lib), "-lm"],
             check=True,
             capture_output=True,
         )

@@ -42,9 +42,11 @@ def block_symbols(terms: ca.Function) -> tuple[ca.SX, list[ca.SX]]:
     return y, [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
 
 
-def block_hessian_function(terms: ca.Function, n_y: int, n_c: int, compile_mode: str) -> ca.Function:
+def block_hessian_function(terms: ca.Function, n_y: int, n_c: int, compile_mode: str,
+                           used: list | None = None) -> ca.Function:
     """Upper-triangular entries (row-major over a <= b) of d2/dy2 [sigma phi(y) + mu . c(y)]. Compiled, it is
-    found in the cache by ``terms`` and this derivation, so that a warm build derives nothing."""
+    found in the cache by ``terms`` and this derivation, so that a warm build derives nothing (``used``:
+    `designopt.transcriptions.compiled.compiled_as`)."""
 
     def derive() -> ca.Function:
         y, params = block_symbols(terms)
@@ -57,7 +59,7 @@ def block_hessian_function(terms: ca.Function, n_y: int, n_c: int, compile_mode:
         return ca.Function("waypoint_hessian", [y, sigma, mu, *params], [upper])
 
     return compiled_as("waypoint_hessian", derivation_identity(terms, block_hessian_function, n_y, n_c), derive,
-                       compile_mode)
+                       compile_mode, used)
 
 
 def derivation_identity(terms: ca.Function, derivation, *args) -> str:

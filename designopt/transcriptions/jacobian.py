@@ -23,15 +23,16 @@ from designopt.transcriptions.compiled import compiled
 from designopt.transcriptions.hessian import block_symbols, ccs_sparsity, per_point
 
 
-def block_jacobian_function(terms: ca.Function, compile_mode: str) -> tuple[ca.Function, np.ndarray, np.ndarray]:
+def block_jacobian_function(terms: ca.Function, compile_mode: str,
+                            used: list | None = None) -> tuple[ca.Function, np.ndarray, np.ndarray]:
     """(function (y, *inputs) -> the structural nonzeros of dc/dy as one column, their rows in c, their columns
-    in y). ``terms`` is a block's (y, *inputs) -> (phi, c)."""
+    in y). ``terms`` is a block's (y, *inputs) -> (phi, c); ``used``: `compiled.compiled_as`."""
     y, params = block_symbols(terms)
     _, c = terms(y, *params)
     J = ca.jacobian(c, y)
     rows, cols = J.sparsity().get_triplet()
     fn = ca.Function("block_jacobian", [y, *params], [ca.vertcat(*J.nonzeros()) if J.nnz() else ca.SX(0, 1)])
-    return compiled(fn, compile_mode), np.asarray(rows, int), np.asarray(cols, int)
+    return compiled(fn, compile_mode, used), np.asarray(rows, int), np.asarray(cols, int)
 
 
 def unclaimed_rows(n_g: int, mu_indices: list[np.ndarray]) -> np.ndarray:
@@ -83,15 +84,15 @@ def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: 
     return ca.Function("jac_g", [X, P], [g_of(X), ca.MX(sp, nz)], ["x", "p"], ["g", "jac_g_x"])
 
 
-def block_gradient_function(terms: ca.Function, compile_mode: str) -> ca.Function | None:
+def block_gradient_function(terms: ca.Function, compile_mode: str, used: list | None = None) -> ca.Function | None:
     """(y, *inputs) -> dphi/dy as a dense column, for a block's (y, *inputs) -> (phi, c); None when phi does not
-    depend on y (a clearance block)."""
+    depend on y (a clearance block). ``used``: `designopt.transcriptions.compiled.compiled_as`."""
     y, params = block_symbols(terms)
     phi, _ = terms(y, *params)
     grad = ca.gradient(phi, y)
     if not grad.nnz():
         return None
-    return compiled(ca.Function("block_gradient", [y, *params], [ca.densify(grad)]), compile_mode)
+    return compiled(ca.Function("block_gradient", [y, *params], [ca.densify(grad)]), compile_mode, used)
 
 
 def assemble_gradient(n_x: int, f_of: ca.Function,

@@ -143,6 +143,7 @@ class NLP:
         self._jacobians: dict[str, object] = {}
         self._gradients: dict[str, object] = {}
         self._values: dict[str, tuple[ca.Function, ca.Function]] = {}
+        self._tiered: dict[str, list] = {}  # per compile mode: the tiered libraries its block functions loaded
 
     @functools.cached_property
     def f(self) -> ca.SX:
@@ -160,6 +161,16 @@ class NLP:
         """The compile mode of a block's functions under the profile's ``compile_mode`` (`compiled.level`)."""
         return level(compile_mode, len(block.y_index))
 
+    def _used(self, compile_mode: str) -> list:
+        """Where the block functions built under ``compile_mode`` note the tiered libraries they load."""
+        return self._tiered.setdefault(compile_mode, [])
+
+    def tiered_libraries(self, compile_mode: str) -> tuple:
+        """The compile cache's -O0 libraries of this NLP's block functions under ``compile_mode`` that tier up to
+        -O1 once solved with long enough (`designopt.transcriptions.compiled.record_work`): empty once they have,
+        or for any mode but ``auto``."""
+        return tuple(dict.fromkeys(self._tiered.get(compile_mode, ())))
+
     def _inputs(self, block: BlockStructure) -> list:
         """A block's constant inputs, one column per point (the toolpath's `waypoint_inputs` unless it has its own)."""
         return list(waypoint_inputs(self.problem.toolpath) if block.inputs is None else block.inputs)
@@ -171,7 +182,7 @@ class NLP:
             return None
         if compile_mode not in self._hessians:
             groups = [(block_hessian_function(b.terms, b.y_index.shape[1], b.mu_index.shape[1],
-                                              self._level(b, compile_mode)),
+                                              self._level(b, compile_mode), self._used(compile_mode)),
                        b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
             self._hessians[compile_mode] = assemble_hessian(self.n_variables, self.n_constraints, groups,
                                                             self._constant_hessian)
@@ -183,8 +194,8 @@ class NLP:
         if self.blocks is None:
             return None
         if compile_mode not in self._jacobians:
-            groups = [(*block_jacobian_function(b.terms, self._level(b, compile_mode)), b.y_index,
-                       self._inputs(b), b.mu_index)
+            groups = [(*block_jacobian_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
+                       b.y_index, self._inputs(b), b.mu_index)
                       for b in self.blocks]
             self._jacobians[compile_mode] = assemble_jacobian(self.x, self.n_constraints, self.constraints.rows,
                                                               self.functions(compile_mode)[1], groups)
@@ -200,7 +211,8 @@ class NLP:
                 self._values[compile_mode] = (ca.Function("nlp_f", [self.x], [self.f]),
                                               ca.Function("nlp_g", [self.x], [self.g]))
             else:
-                groups = [(*(None if fn is None else compiled(fn, self._level(b, compile_mode))
+                groups = [(*(None if fn is None else compiled(fn, self._level(b, compile_mode),
+                                                              self._used(compile_mode))
                              for fn in split_terms(b.terms)),
                            b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
                 self._values[compile_mode] = assemble_values(self.x, self.n_constraints, self.constraints.rows,
@@ -214,8 +226,8 @@ class NLP:
         if self.blocks is None:
             return None
         if compile_mode not in self._gradients:
-            groups = [(block_gradient_function(b.terms, self._level(b, compile_mode)), b.y_index,
-                       self._inputs(b)) for b in self.blocks]
+            groups = [(block_gradient_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
+                       b.y_index, self._inputs(b)) for b in self.blocks]
             self._gradients[compile_mode] = assemble_gradient(self.n_variables, self.functions(compile_mode)[0],
                                                               groups + gradient_groups(self.quadratic))
         return self._gradients[compile_mode]

@@ -1,0 +1,140 @@
+"""Tiered compilation of the per-waypoint blocks (`designopt.transcriptions.compiled`): -O0 first, -O1 once the
+solves that used a block add up to the tier-up threshold. The two levels must compute the same numbers to the last
+bit (a solve may switch levels between runs and must not change), which is checked here against the interpreted
+function as the independent truth."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import casadi as ca
+import numpy as np
+
+from designopt.config import parse_config
+from designopt.problem import problem_from_config
+from designopt.solve import Seeded, SolverProfile, solve_guess
+from designopt.transcriptions import Collocation
+from designopt.transcriptions.compiled import (
+    compiled,
+    library_at,
+    record_work,
+    source_of,
+    tier_up_after,
+)
+from designopt.transcriptions.hessian import block_hessian_function
+
+
+def _stem(library):
+    return library.with_name(library.name.split(".", 1)[0])
+
+
+def _block_terms():
+    """A 3R-like block: (y, s) -> (phi, c) with products of sines and cosines, the shape of a chain's terms."""
+    y, s = ca.SX.sym("y", 6), ca.SX.sym("s", 2)
+    pos = ca.vertcat(y[3] * ca.cos(y[0]) + y[4] * ca.cos(y[0] + y[1]) + y[5] * ca.cos(y[0] + y[1] + y[2]),
+                     y[3] * ca.sin(y[0]) + y[4] * ca.sin(y[0] + y[1]) + y[5] * ca.sin(y[0] + y[1] + y[2]))
+    phi = ca.sumsqr(y[3:] * ca.vertcat(ca.sin(y[1]), ca.cos(y[2]), s[0])) / (1 + ca.sumsqr(pos))
+    return ca.Function("terms", [y, s], [phi, pos - s])
+
+
+def test_o0_and_o1_compute_the_same_bits(tmp_path, monkeypatch):
+    """A Hessian block at -O0 and at -O1 gives identical doubles at 200 random points, both within 1e-12 of the
+    interpreted function."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    terms = _block_terms()
+    levels = {mode: block_hessian_function(terms, 6, 2, mode) for mode in ("none", "O0", "O1")}
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        args = [rng.normal(size=6), rng.normal(), rng.normal(size=2), rng.normal(size=2)]
+        out = {mode: np.array(fn(*args)).ravel() for mode, fn in levels.items()}
+        assert np.array_equal(out["O0"], out["O1"])
+        np.testing.assert_allclose(out["O0"], out["none"], rtol=1e-12, atol=1e-12)
+
+
+def test_a_block_tiers_up_once_its_solves_reach_the_threshold(tmp_path, monkeypatch):
+    """Below the threshold the -O0 library is loaded and reported as used; the solve that reaches it builds -O1
+    (here in the foreground), after which the block loads at -O1, is no longer reported, and computes the same."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "1.0")
+    x = ca.SX.sym("x", 3)
+    fn = ca.Function("blk", [x], [ca.sin(x[0]) * ca.sumsqr(x) + x[1] * x[2]])
+    used = []
+    slow = compiled(fn, "tiered", used)
+    assert len(used) == 1 and used[0].name.endswith(".O0.so") and source_of(_stem(used[0])).exists()
+    assert record_work(used, 0.4, background=False) == []
+    assert not library_at(_stem(used[0]), "O1").exists()
+    assert record_work(used, 0.7, background=False) == used  # 1.1 s in all
+    fast_library = library_at(_stem(used[0]), "O1")
+    assert fast_library.exists()
+    assert not list(tmp_path.glob("*.lock")) and not list(tmp_path.glob("*.tmp"))
+    again = []
+    fast = compiled(fn, "tiered", again)
+    assert again == []  # loaded at -O1: nothing left to count
+    x0 = np.array([0.3, -1.2, 0.7])
+    assert np.array_equal(np.array(fast(x0)), np.array(slow(x0)))
+    assert record_work(used, 5.0, background=False) == []  # already tiered up: nothing built twice
+
+
+def test_tiering_never_and_a_lock_held_elsewhere(tmp_path, monkeypatch):
+    """``never`` records and builds nothing; a build whose lock another process holds is left to it, and a lock
+    older than the stale limit is taken over."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    x = ca.SX.sym("x", 2)
+    used = []
+    compiled(ca.Function("blk2", [x], [ca.cos(x[0]) * x[1]]), "tiered", used)
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "never")
+    assert tier_up_after() is None
+    assert record_work(used, 100.0, background=False) == [] and not list(tmp_path.glob("*.work"))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
+    target = library_at(_stem(used[0]), "O1")
+    lock = target.with_name(target.name + ".lock")
+    lock.touch()
+    assert record_work(used, 1.0, background=False) == [] and not target.exists()
+    old = time.time() - 3600
+    os.utime(lock, (old, old))
+    assert record_work(used, 1.0, background=False) == used and target.exists() and not lock.exists()
+
+
+def test_a_solve_counts_towards_the_tier_up_and_the_background_build_lands(tmp_path, monkeypatch):
+    """Solving with the default compile mode records the solve's seconds against each of the NLP's tiered
+    libraries; at threshold 0 the first solve starts the detached -O1 builds, which land in the cache, and the
+    next build of the same NLP loads them (nothing left to count)."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 6}, "robot": {"structure": "RR",
+                                                                                    "dh": "generic"}}
+    problem = problem_from_config(parse_config(cfg))
+    nlp = Collocation().build(problem).nlp
+    nlp.derivatives("auto")
+    libraries = nlp.tiered_libraries("auto")
+    assert len(libraries) >= 4 and all(lib.name.endswith(".O0.so") for lib in libraries)
+    t0 = time.perf_counter()
+    solve_guess(problem, Collocation(), SolverProfile(max_iter=50), Seeded(0, 0).guess(problem))
+    wall = time.perf_counter() - t0
+    records = list(tmp_path.glob("*.work"))
+    assert len(records) == len(libraries)
+    assert all(0 < float(r.read_text()) <= wall for r in records)  # the solve's own seconds, one line each
+    deadline = time.time() + 120
+    while time.time() < deadline and not all(library_at(_stem(lib), "O1").exists() for lib in libraries):
+        time.sleep(0.2)
+    assert all(library_at(_stem(lib), "O1").exists() for lib in libraries)
+    fresh = Collocation().build(problem).nlp
+    fresh.derivatives("auto")
+    assert fresh.tiered_libraries("auto") == ()
+
+
+def test_a_failed_build_is_not_retried_after_every_solve(tmp_path, monkeypatch):
+    """A compiler that fails leaves no library and keeps the build's lock: the next solves do not start it again
+    (until the lock is stale), and the -O0 library stays in use."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    x = ca.SX.sym("x", 2)
+    used = []
+    compiled(ca.Function("blk3", [x], [ca.exp(x[0]) * x[1]]), "tiered", used)
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
+    monkeypatch.setenv("CC", "false")
+    target = library_at(_stem(used[0]), "O1")
+    assert record_work(used, 1.0, background=False) == used  # started, and failed
+    assert not target.exists() and target.with_name(target.name + ".lock").exists()
+    assert not list(tmp_path.glob("*.tmp*"))
+    assert record_work(used, 1.0, background=False) == []
