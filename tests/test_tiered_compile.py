@@ -138,3 +138,17 @@ def test_a_failed_build_is_not_retried_after_every_solve(tmp_path, monkeypatch):
     assert not target.exists() and target.with_name(target.name + ".lock").exists()
     assert not list(tmp_path.glob("*.tmp*"))
     assert record_work(used, 1.0, background=False) == []
+
+
+def test_a_cache_that_cannot_be_written_leaves_the_solve_alone(tmp_path, monkeypatch):
+    """Counting a solve never fails it: a record that cannot be written (here a directory in its place) is
+    skipped and the block stays at -O0."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
+    x = ca.SX.sym("x", 2)
+    used = []
+    compiled(ca.Function("blk4", [x], [ca.tanh(x[0]) + x[1]]), "tiered", used)
+    stem = _stem(used[0])
+    stem.with_name(stem.name + ".work").mkdir()
+    assert record_work(used, 1.0, background=False) == []
+    assert not library_at(stem, "O1").exists()

@@ -145,9 +145,12 @@ def record_work(libraries: Iterable[Path], seconds: float, background: bool = Tr
         if after is None or library_at(stem, "O1").exists():
             continue
         record = stem.with_name(f"{stem.name}.work")
-        with open(record, "a") as fh:  # one short line per solve: appends from several processes do not mix
-            fh.write(f"{seconds:.3f}\n")
-        total = sum(float(v) for v in record.read_text().split() if _is_number(v))
+        try:
+            with open(record, "a") as fh:  # one short line per solve: appends from several processes do not mix
+                fh.write(f"{seconds:.3f}\n")
+            total = sum(float(v) for v in record.read_text().split() if _is_number(v))
+        except OSError:  # a cache that cannot be written (read-only, full): the block stays at -O0
+            continue
         if total >= after and tier_up(stem, background):
             started.append(library)
     return started
