@@ -152,3 +152,22 @@ def test_a_cache_that_cannot_be_written_leaves_the_solve_alone(tmp_path, monkeyp
     stem.with_name(stem.name + ".work").mkdir()
     assert record_work(used, 1.0, background=False) == []
     assert not library_at(stem, "O1").exists()
+
+
+def test_a_cached_solver_is_built_again_once_its_blocks_tier_up(tmp_path, monkeypatch):
+    """A worker's cached solver whose blocks gained -O1 libraries (here built by hand, as another process would)
+    is prepared anew at its next solve and loads them; until then the same solver is reused."""
+    from designopt.solve import local
+
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 5}, "robot": {"structure": "RR",
+                                                                                    "dh": "generic"}}
+    problem, profile = problem_from_config(parse_config(cfg)), SolverProfile(max_iter=20)
+    built, solver, _ = local.prepared(problem, Collocation(), profile)
+    libraries = built.nlp.tiered_libraries(profile.compile)
+    assert libraries and local.prepared(problem, Collocation(), profile)[1] is solver
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
+    assert record_work(libraries, 1.0, background=False) == list(libraries)
+    again, fresh, spent = local.prepared(problem, Collocation(), profile)
+    assert fresh is not solver and spent > 0 and again.nlp.tiered_libraries(profile.compile) == ()
+    assert local.prepared(problem, Collocation(), profile)[1] is fresh

@@ -156,6 +156,11 @@ def record_work(libraries: Iterable[Path], seconds: float, background: bool = Tr
     return started
 
 
+def tiered_up(libraries: Iterable[Path]) -> bool:
+    """Whether any of these tiered -O0 libraries has an -O1 library in the cache by now (a stat each)."""
+    return any(library_at(_stem(library), "O1").exists() for library in libraries)
+
+
 def tier_up(stem: Path, background: bool = True) -> bool:
     """Build ``stem``'s kept C source at -O1 into its -O1 library (atomically: under a temporary name, then
     renamed), in a detached background process, or here when ``background`` is false. False when there is no
