@@ -447,6 +447,39 @@ def view(
     out.print(f"wrote {path} (open it in a browser: no network needed)")
 
 
+@app.command()
+@user_errors
+def cache(
+    clear: Annotated[bool, typer.Option("--clear", help="Delete every file of the cache (compiled again when "
+                                                        "next needed).")] = False,
+    clear_other: Annotated[bool, typer.Option("--clear-other", help="Delete only the files of no current kind "
+                                                                    "(an older designopt's, a dead build's).")]
+    = False,
+):
+    """Show the compile cache of the per-waypoint blocks (its place, libraries by level, blocks counting towards
+    their -O1 build), or clear it."""
+    from designopt.transcriptions.compiled import cache_report, clear_cache, tier_up_after
+
+    if clear or clear_other:
+        files, freed = clear_cache(only_other=clear_other and not clear)
+        out.print(f"removed {files} files ({freed / 1e6:.1f} MB) from {cache_report().path}")
+        return
+    r = cache_report()
+    after = tier_up_after()
+    table = Table(title=f"compile cache {r.path} ({r.bytes / 1e6:.1f} MB)")
+    table.add_column("what")
+    table.add_column("count", justify="right")
+    table.add_row("libraries at -O0", str(r.libraries["O0"]))
+    table.add_row("libraries at -O1 (tiered up)", f"{r.libraries['O1']} ({r.tiered_up})")
+    table.add_row("libraries at -O2", str(r.libraries["O2"]))
+    most = f"; most {r.counting[0][1]:.1f} s" if r.counting else ""
+    threshold = "never" if after is None else f"{after:g} s of solving"
+    table.add_row(f"blocks counting towards -O1 (at {threshold}){most}", str(len(r.counting)))
+    table.add_row("-O1 builds under way", str(r.building))
+    table.add_row("files of no current kind (--clear-other)", str(r.other))
+    show(table)
+
+
 def main() -> None:
     try:
         app()

@@ -23,6 +23,7 @@ import subprocess
 import tempfile
 import time
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 import casadi as ca
@@ -239,3 +240,73 @@ def _build(source: str, library: Path, mode: str) -> None:
             capture_output=True,
         )
         os.replace(tmp_lib, library)
+
+
+@dataclass(frozen=True)
+class CacheReport:
+    """What the compile cache holds: libraries by level (``tiered_up``: -O1 libraries built from a tiered block's
+    kept source), blocks still counting towards their tier-up and the seconds of solving each has, tier-up builds
+    under way (locks), files of no current kind (an older designopt's libraries, temporary files of a build that
+    died), and the bytes of it all."""
+
+    path: Path
+    libraries: dict[str, int]
+    tiered_up: int
+    counting: tuple[tuple[str, float], ...]
+    building: int
+    other: int
+    bytes: int
+
+
+def _kind(name: str) -> str:
+    """A cache file's kind from its name: ``O0``/``O1``/``O2`` (a library), ``source``, ``work``, ``lock`` or
+    ``other``."""
+    parts = name.split(".")
+    if len(parts) == 3 and parts[2] == "so" and parts[1] in ("O0", "O1", "O2"):
+        return parts[1]
+    if name.endswith(".c.gz") and len(parts) == 3:
+        return "source"
+    if len(parts) == 2 and parts[1] == "work":
+        return "work"
+    if name.endswith(".so.lock") and len(parts) == 4:
+        return "lock"
+    return "other"
+
+
+def cache_report(path: Path | None = None) -> CacheReport:
+    """What the compile cache (`cache_dir`, or ``path``) holds."""
+    path = cache_dir() if path is None else path
+    files = [f for f in path.iterdir() if f.is_file()] if path.is_dir() else []
+    kinds = {f: _kind(f.name) for f in files}
+    names = {f.name for f in files}
+    libraries = {level: sum(k == level for k in kinds.values()) for level in ("O0", "O1", "O2")}
+    stems = {f.name.split(".", 1)[0] for f, k in kinds.items() if k == "source"}
+    tiered_up = sum(1 for s in stems if f"{s}.O1.so" in names)
+    counting = []
+    for f, k in kinds.items():
+        stem = f.name.split(".", 1)[0]
+        if k == "work" and f"{stem}.O1.so" not in names:
+            try:
+                seconds = sum(float(v) for v in f.read_text().split() if _is_number(v))
+            except OSError:
+                continue
+            counting.append((stem, seconds))
+    return CacheReport(path=path, libraries=libraries, tiered_up=tiered_up,
+                       counting=tuple(sorted(counting, key=lambda c: -c[1])),
+                       building=sum(k == "lock" for k in kinds.values()),
+                       other=sum(k == "other" for k in kinds.values()),
+                       bytes=sum(f.stat().st_size for f in files))
+
+
+def clear_cache(path: Path | None = None, only_other: bool = False) -> tuple[int, int]:
+    """Delete the compile cache's files (only those of no current kind with ``only_other``): (files, bytes)
+    removed. Libraries are compiled again when next needed."""
+    path = cache_dir() if path is None else path
+    removed = freed = 0
+    for f in (f for f in path.iterdir() if f.is_file()) if path.is_dir() else ():
+        if only_other and _kind(f.name) != "other":
+            continue
+        size = f.stat().st_size
+        f.unlink(missing_ok=True)
+        removed, freed = removed + 1, freed + size
+    return removed, freed
