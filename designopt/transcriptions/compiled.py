@@ -7,10 +7,11 @@ between processes: each library is written under a temporary name and renamed in
 Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block is first
 compiled at gcc -O0 (about 1 s for the main job's Hessian block) and used so; every solve that used it adds its
 seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the same C source is
-compiled again at -O1 in a background process at the lowest priority (about 10 s for that block), which later
-builds, in any process, load instead. Every library is compiled with ``-ffp-contract=off`` (and never with
--ffast-math), so -O0 and -O1 compute the same IEEE operations in the same order: a solve is the same to the last
-bit at either level, only faster at -O1 (the main job's default search: 0.79x the CPU, docs/benchmarks.md).
+compiled again at -O1 in a detached background process (about 10 s for that block), which later builds, in any
+process, load instead (`designopt cache` shows where each block stands). Every library is compiled with
+``-ffp-contract=off`` (and never with -ffast-math), so -O0 and -O1 compute the same IEEE operations in the same
+order: a solve is the same to the last bit at either level, only faster at -O1 (the main job's default search:
+0.79x the CPU, docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ FLAGS = ("-fPIC", "-shared", "-ffp-contract=off")
 # Below it, ``tiered``: O0 first, O1 once the block has been solved with long enough to pay for it (module doc).
 AUTO_O1_FROM = 500
 # Seconds of solves with a tiered block after which its -O1 build starts: the solving whose -O0 penalty (about a
-# sixth of it on the main job) adds up to what gcc -O1 takes for the main job's blocks (about 10 s) -- the
+# fifth of it on the main job) adds up to what gcc -O1 takes for the main job's blocks (about 10 s) -- the
 # ski-rental rule, which never costs more than twice what knowing the future would. A sweep's structure is solved
 # for about 15 s and never tiers up; a task run again and again does from its second run.
 # `DESIGNOPT_TIER_UP_AFTER` (seconds, or ``never``) overrides it.
@@ -137,7 +138,7 @@ def _stem(library: Path) -> Path:
 def record_work(libraries: Iterable[Path], seconds: float, background: bool = True) -> list[Path]:
     """Count ``seconds`` of solving towards the tier-up of each tiered -O0 library in ``libraries`` (paths that
     `compiled_as` appended to its ``used``), and start the -O1 build of each whose count has reached
-    `tier_up_after` (in a detached background process at the lowest priority unless ``background`` is false;
+    `tier_up_after` (in a detached background process unless ``background`` is false;
     one process builds it, others find its lock). Returns the libraries whose -O1 build this call started."""
     after = tier_up_after()
     started = []
