@@ -44,16 +44,26 @@ def corrected_share(log: str) -> tuple[int, int]:
 
 
 def logged_solve(problem, search, start: int, log: Path):
-    """Solve seeded start ``start`` with IPOPT logging to ``log``: (built NLP, prepared solver, outcome, CPU
-    seconds of the solve, share of inertia-corrected iterations, seconds spent building and preparing)."""
-    profile = replace(search.profile, options=(*search.profile.options, ("ipopt.output_file", str(log)),
+    """Solve seeded start ``start`` with IPOPT's log of this solve written to ``log``: (built NLP, prepared solver,
+    outcome, CPU seconds of the solve, share of inertia-corrected iterations, seconds spent building and
+    preparing). IPOPT logs every start of a directory to one file, ``ipopt.log`` beside ``log`` (it appends), so
+    that the starts share one prepared solver as a run's do: a log file per start was a solver per start, and
+    with it the observers built anew (the degenerate watch's tracking Jacobian: 0.1 ms per iteration of the
+    exploration that no run pays)."""
+    shared = log.parent / "ipopt.log"
+    profile = replace(search.profile, options=(*search.profile.options, ("ipopt.output_file", str(shared)),
                                                ("ipopt.file_print_level", 5)))
     built, solver, build_s = local.prepared(problem, Collocation(), profile)
     guess = initial_guess(problem, start, search.seed, search.perturbation, search.init)
+    before = shared.stat().st_size if shared.exists() else 0
     cpu = time.process_time()
     outcome = solver.solve(built.pack(guess))
     total = time.process_time() - cpu
-    corrected, counted = corrected_share(log.read_text())
+    with open(shared, "rb") as fh:
+        fh.seek(before)
+        text = fh.read().decode(errors="replace")
+    log.write_text(text)
+    corrected, counted = corrected_share(text)
     return built, solver, outcome, total, corrected / max(counted, 1), build_s
 
 
