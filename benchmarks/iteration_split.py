@@ -46,11 +46,11 @@ def corrected_share(log: str) -> tuple[int, int]:
 def logged_solve(problem, search, start: int, log: Path):
     """Solve seeded start ``start`` with IPOPT's log of this solve written to ``log``: (built NLP, prepared solver,
     outcome, CPU seconds of the solve, share of inertia-corrected iterations, seconds spent building and
-    preparing). IPOPT logs every start of a directory to one file, ``ipopt.log`` beside ``log`` (it appends), so
-    that the starts share one prepared solver as a run's do: a log file per start was a solver per start, and
-    with it the observers built anew (the degenerate watch's tracking Jacobian: 0.1 ms per iteration of the
-    exploration that no run pays)."""
-    shared = log.parent / "ipopt.log"
+    preparing). IPOPT logs every start of one label (``log``'s name without its start number) to one file beside
+    ``log`` (it appends), so that the starts share one prepared solver as a run's do: a log file per start was a
+    solver per start, and with it the observers built anew (the degenerate watch's tracking Jacobian: 0.1 ms per
+    iteration of the exploration that no run pays)."""
+    shared = log.parent / f"ipopt-shared-{log.stem.rstrip('0123456789')}.log"
     profile = replace(search.profile, options=(*search.profile.options, ("ipopt.output_file", str(shared)),
                                                ("ipopt.file_print_level", 5)))
     built, solver, build_s = local.prepared(problem, Collocation(), profile)
