@@ -251,6 +251,28 @@ def test_the_ik_residual_is_the_numpy_kinematics_and_its_jacobian_their_derivati
         np.testing.assert_allclose(J_d, fd_d, atol=1e-7)
 
 
+@pytest.mark.parametrize("dh", ["puma560", "generic"])
+def test_the_walks_in_place_residual_gives_the_same_bits(dh):
+    """The IK walks' in-place residual (`point_residual`: a FunctionBuffer, no design Jacobian, dense) returns
+    exactly `residual_function`'s r and dr/dq, also where a joint moves no row (the PUMA's last joint turns
+    about the tool axis: a column of zeros), and copies that later calls do not overwrite."""
+    from designopt.initial_guess import point_residual, residual_function
+
+    problem = problem_from_config(parse_config({"robot": {"structure": "RRRRRR", "dh": dh},
+                                                "design": ["d", "a", "alpha", "placement"]}))
+    fn, fast, rng = residual_function(problem), point_residual(problem), np.random.default_rng(5)
+    kept = []
+    for _ in range(50):
+        q = rng.uniform(-2, 2, problem.chain.n_moving)
+        q_d = problem.chain.design_values + rng.uniform(-0.2, 0.2, problem.chain.n_design)
+        s = rng.uniform(-0.3, 0.3, 3)
+        r, J_q, _ = fn(q, q_d, s)
+        ours = fast(q, q_d, s)
+        assert np.array_equal(ours[0], np.array(r).ravel()) and np.array_equal(ours[1], np.array(J_q))
+        kept.append((ours, np.array(r).ravel()))
+    assert all(np.array_equal(ours[0], r) for ours, r in kept)
+
+
 def test_a_failed_solve_is_a_result_not_an_exception(gantry_problem):
     raw = solve_from(gantry_problem, initial_guesses(gantry_problem, 1, 0, 0.3, "constant")[0], max_iter=2).raw
     assert not raw.success
