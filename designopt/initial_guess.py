@@ -137,14 +137,14 @@ def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks:
     """(Q, residuals): damped least squares at waypoints ``ks`` from the rows of ``Q`` (len(ks) x n_moving), each
     waypoint with its own damping; a step that does not lower a waypoint's residual is not taken."""
     n, n_m = Q.shape
-    fn = residual_function(problem).map(n)
+    fn = point_residual(problem).fn.map(n)  # r and dr/dq only: the design is held
     S = problem.toolpath.points_W[ks].T
     D = np.tile(np.asarray(q_d, float)[:, None], (1, n))
     lo = np.array([j.lower for j in problem.chain.moving])
     hi = np.array([j.upper for j in problem.chain.moving])
 
     def evaluate(Q):  # residuals (n x 6) and Jacobians (n x 6 x n_m)
-        r, J_q, _ = fn(Q.T, D, S)
+        r, J_q = fn(Q.T, D, S)
         return np.array(r).T, np.array(J_q).reshape(6, n, n_m).transpose(1, 0, 2)
 
     Q = np.array(Q, dtype=float)
