@@ -76,7 +76,8 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     points = problem.toolpath.points_W
 
     def residual(q, k):
-        return fn(q, q_d, points[k])
+        r, J_q = fn(q, q_d, points[k])
+        return r.ravel(), J_q
 
     lo = np.array([j.lower for j in problem.chain.moving])
     hi = np.array([j.upper for j in problem.chain.moving])
@@ -226,7 +227,8 @@ def _residual_function(payload: bytes):
 
 
 def point_residual(problem: DesignProblem):
-    """(q, q_d, s_W) -> (r, dr/dq) of `residual_function` at one point as new numpy arrays, evaluated in place
+    """(q, q_d, s_W) -> (r, dr/dq) of `residual_function` at one point as new numpy arrays (6 x 1, 6 x n_moving),
+    evaluated in place
     on buffers (CasADi's FunctionBuffer) by a function without dr/dq_d: the same numbers as calling
     `residual_function`, at 21 instead of 75 us a call (a DM per argument and result, and the design Jacobian an
     IK walk does not use; the seeded starts' walks make ~100 calls per waypoint). Built once per chain in a
@@ -253,8 +255,7 @@ class _InPlace:
         for buffer, value in zip(self._args, args, strict=True):
             buffer[:] = np.ravel(value, order="F")
         self._eval()
-        return [r.reshape(shape, order="F").copy() if shape[1] > 1 else r.copy()
-                for r, shape in zip(self._res, self._shapes, strict=True)]
+        return [r.reshape(shape, order="F").copy() for r, shape in zip(self._res, self._shapes, strict=True)]
 
 
 @functools.lru_cache(maxsize=16)

@@ -251,14 +251,14 @@ def test_the_ik_residual_is_the_numpy_kinematics_and_its_jacobian_their_derivati
         np.testing.assert_allclose(J_d, fd_d, atol=1e-7)
 
 
-@pytest.mark.parametrize("dh", ["puma560", "generic"])
-def test_the_walks_in_place_residual_gives_the_same_bits(dh):
+@pytest.mark.parametrize("structure,dh", [("RRRRRR", "puma560"), ("RRRRRR", "generic"), ("P", "generic")])
+def test_the_walks_in_place_residual_gives_the_same_bits(structure, dh):
     """The IK walks' in-place residual (`point_residual`: a FunctionBuffer, no design Jacobian, dense) returns
-    exactly `residual_function`'s r and dr/dq, also where a joint moves no row (the PUMA's last joint turns
-    about the tool axis: a column of zeros), and copies that later calls do not overwrite."""
+    exactly `residual_function`'s r and dr/dq (as 6 x 1 and 6 x n matrices, one joint too), also where a joint
+    moves no row (a column of zeros), and copies that later calls do not overwrite."""
     from designopt.initial_guess import point_residual, residual_function
 
-    problem = problem_from_config(parse_config({"robot": {"structure": "RRRRRR", "dh": dh},
+    problem = problem_from_config(parse_config({"robot": {"structure": structure, "dh": dh},
                                                 "design": ["d", "a", "alpha", "placement"]}))
     fn, fast, rng = residual_function(problem), point_residual(problem), np.random.default_rng(5)
     kept = []
@@ -268,8 +268,8 @@ def test_the_walks_in_place_residual_gives_the_same_bits(dh):
         s = rng.uniform(-0.3, 0.3, 3)
         r, J_q, _ = fn(q, q_d, s)
         ours = fast(q, q_d, s)
-        assert np.array_equal(ours[0], np.array(r).ravel()) and np.array_equal(ours[1], np.array(J_q))
-        kept.append((ours, np.array(r).ravel()))
+        assert np.array_equal(ours[0], np.array(r)) and np.array_equal(ours[1], np.array(J_q))
+        kept.append((ours, np.array(r)))
     assert all(np.array_equal(ours[0], r) for ours, r in kept)
 
 
