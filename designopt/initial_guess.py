@@ -228,11 +228,10 @@ def _residual_function(payload: bytes):
 
 def point_residual(problem: DesignProblem):
     """(q, q_d, s_W) -> (r, dr/dq) of `residual_function` at one point as new numpy arrays (6 x 1, 6 x n_moving),
-    evaluated in place
-    on buffers (CasADi's FunctionBuffer) by a function without dr/dq_d: the same numbers as calling
-    `residual_function`, at 21 instead of 75 us a call (a DM per argument and result, and the design Jacobian an
-    IK walk does not use; the seeded starts' walks make ~100 calls per waypoint). Built once per chain in a
-    process."""
+    evaluated in place on buffers (CasADi's FunctionBuffer) by a function without dr/dq_d: the same numbers as
+    calling `residual_function`, at 21 instead of 75 us a call (a DM per argument and result, and the design
+    Jacobian an IK walk does not use; the seeded starts' walks make ~100 calls per waypoint). Built once per chain
+    in a process."""
     return _point_residual(pickle.dumps(problem.chain))
 
 
@@ -262,12 +261,11 @@ class _InPlace:
 def _point_residual(payload: bytes):
     import casadi as ca
 
-    chain = pickle.loads(payload)
-    q, q_d, s_W = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design), ca.SX.sym("s_W", 3)
-    r = ca.vertcat(*tracking_residual(waypoint(chain, q, q_d, s_W, ca.SX.zeros(3), None, "full")))
-    # the same graph as `_residual_function`'s first two outputs; dense, so that a joint no row depends on (a last
-    # joint turning about the tool axis) is a column of zeros in the buffer
-    return _InPlace(ca.Function("tracking_residual_q", [q, q_d, s_W], [ca.densify(r), ca.densify(ca.jacobian(r, q))]))
+    full = _residual_function(payload)
+    args = [ca.SX.sym(full.name_in(i), full.sparsity_in(i)) for i in range(full.n_in())]
+    r, J_q, _ = full(*args)  # its graph inlined; the design Jacobian, which nothing reads, dropped
+    # dense, so that a joint no row depends on (a last joint turning about the tool axis) is a column of zeros
+    return _InPlace(ca.Function("tracking_residual_q", args, [ca.densify(r), ca.densify(J_q)]))
 
 
 def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik",

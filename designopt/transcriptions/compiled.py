@@ -177,8 +177,8 @@ def tier_up(stem: Path, background: bool = True) -> bool:
     q = shlex.quote
     try:
         c_file.write_bytes(gzip.decompress(source.read_bytes()))
-        compiler, c, out = q(os.environ.get("CC", "gcc")), q(str(c_file)), q(str(tmp))
-        build = (f"{compiler} -O1 {' '.join(FLAGS)} {c} -o {out} -lm && mv -f {out} {q(str(target))} && "
+        c, out = q(str(c_file)), q(str(tmp))
+        build = (f"{shlex.join(_compile_command(c_file, tmp, 'O1'))} && mv -f {out} {q(str(target))} && "
                  f"rm -f {q(str(lock))}; rm -f {out} {c}")
         # in the background the shell returns at once and the build, orphaned, outlives this process
         command = f"({build}) >/dev/null 2>&1" + (" &" if background else "")
@@ -234,13 +234,14 @@ def _build(source: str, library: Path, mode: str) -> None:
         c_file = Path(tmp) / "fn.c"
         c_file.write_text(source)
         tmp_lib = Path(tmp) / library.name
-        compiler = os.environ.get("CC", "gcc")
-        subprocess.run(
-            [compiler, f"-{mode}", *FLAGS, str(c_file), "-o", str(tmp_lib), "-lm"],
-            check=True,
-            capture_output=True,
-        )
+        subprocess.run(_compile_command(c_file, tmp_lib, mode), check=True, capture_output=True)
         os.replace(tmp_lib, library)
+
+
+def _compile_command(c_file: Path, library: Path, mode: str) -> list[str]:
+    """The compiler's command line that builds ``c_file`` into the shared library ``library`` at level ``mode``
+    ($CC, or gcc)."""
+    return [os.environ.get("CC", "gcc"), f"-{mode}", *FLAGS, str(c_file), "-o", str(library), "-lm"]
 
 
 @dataclass(frozen=True)
@@ -281,11 +282,11 @@ def cache_report(path: Path | None = None) -> CacheReport:
     kinds = {f: _kind(f.name) for f in files}
     names = {f.name for f in files}
     libraries = {level: sum(k == level for k in kinds.values()) for level in ("O0", "O1", "O2")}
-    stems = {f.name.split(".", 1)[0] for f, k in kinds.items() if k == "source"}
+    stems = {_stem(f).name for f, k in kinds.items() if k == "source"}
     tiered_up = sum(1 for s in stems if f"{s}.O1.so" in names)
     counting = []
     for f, k in kinds.items():
-        stem = f.name.split(".", 1)[0]
+        stem = _stem(f).name
         if k == "work" and f"{stem}.O1.so" not in names:
             try:
                 seconds = sum(float(v) for v in f.read_text().split() if _is_number(v))
