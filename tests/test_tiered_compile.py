@@ -39,8 +39,8 @@ def _block_terms():
 
 
 def test_o0_and_o1_compute_the_same_bits(tmp_path, monkeypatch):
-    """A Hessian block at -O0 and at -O1 gives identical doubles at 200 random points, both within 1e-12 of the
-    interpreted function."""
+    """A Hessian block at -O0 and at -O1 gives identical doubles at 200 random points, and so does the interpreted
+    function (CasADi's virtual machine runs the same IEEE operations in the same order as the generated C)."""
     monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
     terms = _block_terms()
     levels = {mode: block_hessian_function(terms, 6, 2, mode) for mode in ("none", "O0", "O1")}
@@ -48,8 +48,7 @@ def test_o0_and_o1_compute_the_same_bits(tmp_path, monkeypatch):
     for _ in range(200):
         args = [rng.normal(size=6), rng.normal(), rng.normal(size=2), rng.normal(size=2)]
         out = {mode: np.array(fn(*args)).ravel() for mode, fn in levels.items()}
-        assert np.array_equal(out["O0"], out["O1"])
-        np.testing.assert_allclose(out["O0"], out["none"], rtol=1e-12, atol=1e-12)
+        assert np.array_equal(out["O0"], out["O1"]) and np.array_equal(out["O0"], out["none"])
 
 
 def test_a_block_tiers_up_once_its_solves_reach_the_threshold(tmp_path, monkeypatch):
