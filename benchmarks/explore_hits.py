@@ -12,16 +12,18 @@ search that uses the better one on the seed distribution.
 
     .venv/bin/python benchmarks/explore_hits.py [--config configs/milling.yaml]
         [--reference benchmarks/reference/milling_best_known.json] [--first-seed 100] [--seeds 5] [--starts 80]
-        [--scale 0.3 | --spread box] [--waypoints 10] [--max-iter 250] [--jobs 2]
+        [--scale 0.3 | --spread box] [--waypoints 10] [--max-iter 250] [--jobs 2] [--option ipopt.KEY=VALUE ...]
 """
 
 from __future__ import annotations
 
 import argparse
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from solver_options import parse_options
 
 from designopt.config import load_config
 from designopt.initial_guess import SPREADS
@@ -47,6 +49,8 @@ def main() -> None:
     parser.add_argument("--waypoints", type=int, default=None, help="default: the search's explore_waypoints")
     parser.add_argument("--max-iter", type=int, default=None, help="default: the search's explore_max_iter")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="an nlpsol option for the exploration's solves, e.g. ipopt.max_soc=0 (repeatable)")
     args = parser.parse_args()
 
     search = preset("default")
@@ -63,6 +67,7 @@ def main() -> None:
     known = ref.metrics.design_cost
 
     profile, hold = solve_setup(job, search, search.profile.capped(args.max_iter or search.explore_max_iter))
+    profile = replace(profile, options=(*profile.options, *parse_options(args.option)))
     seeds = range(args.first_seed, args.first_seed + args.seeds)
 
     tasks = [Task("hits", "explore", coarse, Collocation(), profile,
@@ -75,6 +80,7 @@ def main() -> None:
     cpu = sum(sol.raw.solve_time_s for _, sol in done)
     n = len(ratio)
     how = "the task's box" if args.spread == "box" else f"perturbation {scale}"
+    how += "".join(f", {k} {v}" for k, v in parse_options(args.option))
     print(f"{args.config}: {n} starts ({len(seeds)} seeds x {args.starts}; {how}) on {waypoints} waypoints, "
           f"<= {args.max_iter or search.explore_max_iter} iterations; best known there {known:.4g}")
     for level in (1.02, 1.10, 1.30):
