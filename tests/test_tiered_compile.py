@@ -174,7 +174,8 @@ def test_a_cached_solver_is_built_again_once_its_blocks_tier_up(tmp_path, monkey
 
 def test_the_cache_command_counts_levels_and_records_and_clears(tmp_path, monkeypatch):
     """`designopt cache` reports a tiered block at -O0 counting its solves, then tiered up at -O1, and a file of
-    no current kind (an older designopt's library); --clear-other removes only that one, --clear the rest."""
+    no current kind (an older designopt's library); --clear-other removes only that one (not the KKT solver's
+    library), --clear the rest."""
     from typer.testing import CliRunner
 
     from cli.main import app
@@ -186,6 +187,7 @@ def test_the_cache_command_counts_levels_and_records_and_clears(tmp_path, monkey
     used = []
     compiled(ca.Function("blk5", [x], [ca.sin(x[0]) * x[1]]), "tiered", used)
     (tmp_path / "waypoint_hessian_0123456789abcdef0123.so").write_bytes(b"old")
+    (tmp_path / "ldl_0123456789abcdef0123.so").write_bytes(b"kkt")  # the KKT solver's library: a current kind
     record_work(used, 1.5, background=False)
     report = cache_report()
     assert report.libraries == {"O0": 1, "O1": 0, "O2": 0} and report.other == 1
@@ -198,5 +200,6 @@ def test_the_cache_command_counts_levels_and_records_and_clears(tmp_path, monkey
     assert shown.exit_code == 0 and "at 2.5 s of solving" in shown.output and str(tmp_path) in shown.output
     assert runner.invoke(app, ["cache", "--clear-other"]).exit_code == 0
     assert cache_report().other == 0 and cache_report().libraries["O1"] == 1
+    assert (tmp_path / "ldl_0123456789abcdef0123.so").exists()
     cleared = runner.invoke(app, ["cache", "--clear"])
     assert cleared.exit_code == 0 and "removed" in cleared.output and not list(tmp_path.iterdir())

@@ -261,9 +261,11 @@ class CacheReport:
 
 
 def _kind(name: str) -> str:
-    """A cache file's kind from its name: ``O0``/``O1``/``O2`` (a library), ``source``, ``work``, ``lock`` or
-    ``other``."""
+    """A cache file's kind from its name: ``O0``/``O1``/``O2`` (a library), ``source``, ``work``, ``lock``, ``ldl``
+    (the KKT solver's library, `designopt.solve.backends.ldl`) or ``other``."""
     parts = name.split(".")
+    if name.startswith("ldl_") and len(parts) == 2 and parts[1] == "so":
+        return "ldl"
     if len(parts) == 3 and parts[2] == "so" and parts[1] in ("O0", "O1", "O2"):
         return parts[1]
     if name.endswith(".c.gz") and len(parts) == 3:

@@ -1,0 +1,280 @@
+/* MA27's four calls -- ma27id, ma27ad, ma27bd, ma27cd, as IPOPT loads them at run time from the library its
+ * `hsllib` option names -- over an AMD ordering (SuiteSparse AMD, amd/) and QDLDL's sparse LDL^T (qdldl.c).
+ *
+ * This is not MA27: there is no numerical pivoting. A pivot that is exactly zero is reported as a singular matrix
+ * (IFLAG -5), which IPOPT answers by regularising the constraint block (delta_c > 0, after which the KKT matrix
+ * is quasi-definite whenever its Hessian block is positive definite on the null space); the inertia is the signs
+ * of D (Sylvester's law), which IPOPT checks and corrects as with any solver that reports it.
+ *
+ * Where MA27 keeps things, this keeps them too, so that nothing is allocated between calls and nothing leaks when
+ * IPOPT drops a solver: the ordering in IKEEP (3n ints, from ma27ad on), the factors in A (doubles) and IW (ints),
+ * whose sizes ma27ad asks for through INFO(5) and INFO(6). Layouts:
+ *   IKEEP: P[n] (new -> old), Pinv[n] (old -> new), nnzA, nnzL, generation (a number per analysis, n > 2)
+ *   IW: header[HDR] | Ap[n+1] Ai[nnzA] (the permuted upper triangle, every diagonal present) | Lp[n+1] Li[nnzL] |
+ *       etree[n] Lnz[n] | iwork[3n] (QDLDL's; after a factorisation its first n hold P for ma27cd) |
+ *       bwork[n] (QDLDL's; after a factorisation bwork[0] holds the offset of Lx in A) | map[nz] (triplet ->
+ *       Ai slot) | diag[n] | scratch for building the pattern [2 nz + 2 n]
+ *   A: the triplets' values[nz] (written by IPOPT) | Ax[nnzA] | Lx[nnzL] | D[n] | Dinv[n] | fwork[n] | x[n]
+ * The pattern of IW is built at the first factorisation of an analysis and reused by the next ones (header:
+ * MAGIC, n, nz, generation, nnzL, LIW), so a factorisation is a scatter of the values and QDLDL's numeric pass.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "amd.h"
+#include "qdldl.h"
+
+#define HDR 8
+#define MAGIC 0x4d413237
+#define WEAK 1e-7 /* a diagonal entry this small counts as zero for the ordering (IPOPT's delta_c <= 1e-8) */
+
+static int ints_needed(int n, int nz, int nnzA, int nnzL) {
+    return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + 3 * n + n + nz + n + (2 * nz + 2 * n);
+}
+
+static int doubles_needed(int n, int nz, int nnzA, int nnzL) { return nz + nnzA + nnzL + 4 * n; }
+
+/* The permuted upper triangle of the (1-based) triplets with every diagonal present, duplicates merged: its
+ * columns Ap[n+1] and sorted rows Ai, and for each triplet its slot in Ai (map[nz]). Ai needs nz + n slots while it
+ * is built. Returns nnzA, or -1 when out of memory. */
+static int pattern(int n, int nz, const int *irn, const int *icn, const int *pinv, int *Ap, int *Ai, int *map) {
+    int j, k, p, total, unique = 0;
+    int *next = (int *)malloc(sizeof(int) * (n + 1));
+    int *order = (int *)malloc(sizeof(int) * (nz + n + 1));
+    int *slot = (int *)malloc(sizeof(int) * (nz + n + 1));
+    int *rows = (int *)malloc(sizeof(int) * (nz + n + 1));
+    int *counts = (int *)calloc(n + 1, sizeof(int));
+    if (!next || !order || !slot || !rows || !counts) {
+        free(next); free(order); free(slot); free(rows); free(counts);
+        return -1;
+    }
+    for (j = 0; j <= n; j++) Ap[j] = 0;
+    for (k = 0; k < nz; k++) {
+        int a = pinv[irn[k] - 1], b = pinv[icn[k] - 1];
+        Ap[(a > b ? a : b) + 1]++;
+    }
+    for (j = 0; j < n; j++) Ap[j + 1] += Ap[j] + 1; /* + the diagonal */
+    total = Ap[n];
+    for (j = 0; j < n; j++) { rows[Ap[j]] = j; next[j] = Ap[j] + 1; }
+    for (k = 0; k < nz; k++) {
+        int a = pinv[irn[k] - 1], b = pinv[icn[k] - 1];
+        int col = a > b ? a : b;
+        map[k] = next[col];
+        rows[next[col]++] = a < b ? a : b;
+    }
+    /* each column's entries sorted by row (insertion sort: columns are short), duplicates merged */
+    for (j = 0; j < n; j++) {
+        int start = Ap[j], len = Ap[j + 1] - Ap[j], last = -1;
+        for (p = 0; p < len; p++) {
+            int key = start + p, q = p - 1;
+            while (q >= 0 && rows[order[start + q]] > rows[key]) { order[start + q + 1] = order[start + q]; q--; }
+            order[start + q + 1] = key;
+        }
+        for (p = 0; p < len; p++) {
+            int s = order[start + p];
+            if (rows[s] != last) { last = rows[s]; Ai[unique++] = last; }
+            slot[s] = unique - 1;
+        }
+        counts[j + 1] = unique;
+    }
+    for (k = 0; k < nz; k++) map[k] = slot[map[k]];
+    memcpy(Ap, counts, sizeof(int) * (n + 1));
+    free(next); free(order); free(slot); free(rows); free(counts);
+    (void)total;
+    return unique;
+}
+
+/* The ordering P (new -> old) changed so that no node whose diagonal is zero (a constraint row of IPOPT's KKT
+ * matrix, whether delta_c is 0 or 1e-8 mu^0.25) is eliminated before one of its neighbours: its pivot is then the
+ * fill its eliminated neighbours left (-J^2 / H) instead of an exact zero or -delta_c. Not a guarantee: two rows
+ * whose only eliminated neighbour is the same variable leave a rank-one block, whose second pivot is zero (reported
+ * as singular) or tiny (benchmarks/kkt_ldl.py counts how often). Nodes keep AMD's order otherwise; a deferred node
+ * follows the node that frees it. Returns 0, or -1 when out of memory. */
+static int defer_zero_pivots(int n, int nz, const int *IRN, const int *ICN, const double *A, int *P, int *Pinv) {
+    int j, k, q, placed = 0;
+    double *diag = (double *)calloc(n, sizeof(double));
+    char *zero = (char *)malloc(n), *done = (char *)calloc(n, 1), *waiting = (char *)calloc(n, 1);
+    int *Cp = (int *)calloc(n + 1, sizeof(int)), *Ci = (int *)malloc(sizeof(int) * (2 * nz + 1));
+    int *fill = (int *)malloc(sizeof(int) * (n + 1)), *order = (int *)malloc(sizeof(int) * (n + 1));
+    int *stack = (int *)malloc(sizeof(int) * (2 * nz + n + 1));
+    if (!diag || !zero || !done || !waiting || !Cp || !Ci || !fill || !order || !stack) {
+        free(diag); free(zero); free(done); free(waiting); free(Cp); free(Ci); free(fill); free(order);
+        free(stack);
+        return -1;
+    }
+    for (k = 0; k < nz; k++)
+        if (IRN[k] == ICN[k]) diag[IRN[k] - 1] += A[k];
+    /* zero, or as good as zero: a regularised constraint row's -delta_c (1e-8 mu^0.25) is no pivot to divide by */
+    for (j = 0; j < n; j++) zero[j] = fabs(diag[j]) <= WEAK;
+    for (k = 0; k < nz; k++) {
+        int a = IRN[k] - 1, b = ICN[k] - 1;
+        if (a != b) { Cp[b + 1]++; Cp[a + 1]++; }
+    }
+    for (j = 0; j < n; j++) Cp[j + 1] += Cp[j];
+    memcpy(fill, Cp, sizeof(int) * (n + 1));
+    for (k = 0; k < nz; k++) {
+        int a = IRN[k] - 1, b = ICN[k] - 1;
+        if (a != b) { Ci[fill[b]++] = a; Ci[fill[a]++] = b; }
+    }
+    for (j = 0; j < n; j++) {
+        int top = 0;
+        stack[top++] = P[j];
+        while (top > 0) { /* a node, then every waiting node it may free, in turn */
+            int u = stack[--top], partner = -1;
+            if (done[u]) continue;
+            if (zero[u]) { /* waits for an eliminated neighbour */
+                for (q = Cp[u]; q < Cp[u + 1] && partner < 0; q++)
+                    if (done[Ci[q]]) partner = Ci[q];
+                if (partner < 0) { waiting[u] = 1; continue; }
+            }
+            done[u] = 1;
+            waiting[u] = 0;
+            order[placed++] = u;
+            for (q = Cp[u]; q < Cp[u + 1]; q++)
+                if (waiting[Ci[q]]) stack[top++] = Ci[q];
+        }
+    }
+    for (j = 0; j < n; j++) /* nodes nothing freed: where AMD put them, at the end */
+        if (!done[P[j]]) { done[P[j]] = 1; order[placed++] = P[j]; }
+    memcpy(P, order, sizeof(int) * n);
+    for (j = 0; j < n; j++) Pinv[P[j]] = j;
+    free(diag); free(zero); free(done); free(waiting); free(Cp); free(Ci); free(fill); free(order); free(stack);
+    return 0;
+}
+
+/* nnzA and nnzL of ordering Pinv, or -1. */
+static int factor_sizes(int n, int nz, const int *IRN, const int *ICN, const int *Pinv, int *nnzA, int *nnzL) {
+    int *Ap = (int *)malloc(sizeof(int) * (n + 1)), *Ai = (int *)malloc(sizeof(int) * (nz + n + 1));
+    int *map = (int *)malloc(sizeof(int) * (nz + 1)), *work = (int *)malloc(sizeof(int) * (n + 1));
+    int *Lnz = (int *)malloc(sizeof(int) * (n + 1)), *etree = (int *)malloc(sizeof(int) * (n + 1));
+    *nnzA = (Ap && Ai && map && work && Lnz && etree) ? pattern(n, nz, IRN, ICN, Pinv, Ap, Ai, map) : -1;
+    *nnzL = *nnzA >= 0 ? QDLDL_etree(n, Ap, Ai, work, Lnz, etree) : -1;
+    free(Ap); free(Ai); free(map); free(work); free(Lnz); free(etree);
+    return *nnzL < 0 ? -1 : 0;
+}
+
+static void ma27i(int *ICNTL, double *CNTL) {
+    memset(ICNTL, 0, 30 * sizeof(int));
+    memset(CNTL, 0, 5 * sizeof(double));
+    CNTL[0] = 0.1;
+}
+
+static void ma27a(int *N, int *NZ, const int *IRN, const int *ICN, int *IKEEP, int *NSTEPS, int *INFO, double *OPS) {
+    static int generations = 0;
+    int n = *N, nz = *NZ, j, k, status, nnzA, nnzL;
+    double control[AMD_CONTROL], info[AMD_INFO];
+    int *P = IKEEP, *Pinv = IKEEP + n;
+    memset(INFO, 0, 20 * sizeof(int));
+    *NSTEPS = 1;
+    /* AMD on the pattern of both triangles */
+    int *Cp = (int *)calloc(n + 1, sizeof(int)), *Ci = (int *)malloc(sizeof(int) * (2 * nz + 1));
+    int *fill = (int *)malloc(sizeof(int) * (n + 1));
+    if (!Cp || !Ci || !fill) { free(Cp); free(Ci); free(fill); INFO[0] = -1; return; }
+    for (k = 0; k < nz; k++) {
+        int a = IRN[k] - 1, b = ICN[k] - 1;
+        if (a != b) { Cp[b + 1]++; Cp[a + 1]++; }
+    }
+    for (j = 0; j < n; j++) Cp[j + 1] += Cp[j];
+    memcpy(fill, Cp, sizeof(int) * (n + 1));
+    for (k = 0; k < nz; k++) {
+        int a = IRN[k] - 1, b = ICN[k] - 1;
+        if (a != b) { Ci[fill[b]++] = a; Ci[fill[a]++] = b; }
+    }
+    amd_defaults(control);
+    status = amd_order(n, Cp, Ci, P, control, info);
+    free(Cp); free(Ci); free(fill);
+    if (status < 0) { INFO[0] = -1; return; }
+    for (j = 0; j < n; j++) Pinv[P[j]] = j;
+    /* the sizes of the factors, for the workspace IPOPT allocates (ma27b may reorder and ask for more) */
+    if (factor_sizes(n, nz, IRN, ICN, Pinv, &nnzA, &nnzL) < 0) { INFO[0] = -1; return; }
+    IKEEP[2 * n] = nnzA;
+    if (n > 1) IKEEP[2 * n + 1] = nnzL;
+    if (n > 2) IKEEP[2 * n + 2] = (++generations & 0x3fffffff) + 1;
+    if (n > 3) IKEEP[2 * n + 3] = 0; /* not yet reordered for the first matrix's zero diagonal */
+    *OPS = (double)nnzL;
+    INFO[4] = doubles_needed(n, nz, nnzA, nnzL);
+    INFO[5] = ints_needed(n, nz, nnzA, nnzL);
+}
+
+static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, int *LA, int *IW, int *LIW,
+                  int *IKEEP, int *MAXFRT, int *INFO) {
+    int n = *N, nz = *NZ, k, pos;
+    memset(INFO, 0, 20 * sizeof(int));
+    if (n > 3 && IKEEP[2 * n + 3] == 0) { /* the first matrix of this analysis: its zero diagonal decides */
+        int nnzA, nnzL;
+        if (defer_zero_pivots(n, nz, IRN, ICN, A, IKEEP, IKEEP + n) < 0 ||
+            factor_sizes(n, nz, IRN, ICN, IKEEP + n, &nnzA, &nnzL) < 0) { INFO[0] = -1; return; }
+        IKEEP[2 * n] = nnzA;
+        IKEEP[2 * n + 1] = nnzL;
+        IKEEP[2 * n + 3] = 1;
+    }
+    const int *Pinv = IKEEP + n;
+    int nnzA = IKEEP[2 * n], nnzL = n > 1 ? IKEEP[2 * n + 1] : 0, generation = n > 2 ? IKEEP[2 * n + 2] : -1;
+    int ineed = ints_needed(n, nz, nnzA, nnzL), dneed = doubles_needed(n, nz, nnzA, nnzL);
+    *MAXFRT = 1;
+    if (*LIW < ineed) { INFO[0] = -3; INFO[1] = ineed; return; }
+    if (*LA < dneed) { INFO[0] = -4; INFO[1] = dneed; return; }
+    int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
+    int *Lnz = etree + n, *iwork = Lnz + n, *bwork = iwork + 3 * n, *map = bwork + n, *diag = map + nz;
+    int *scratch = diag + n; /* 2 nz + 2 n */
+    int cached = generation > 0 && IW[0] == MAGIC && IW[1] == n && IW[2] == nz && IW[3] == generation &&
+                 IW[4] == nnzA && IW[5] == nnzL && IW[6] == *LIW;
+    if (!cached) {
+        if (pattern(n, nz, IRN, ICN, Pinv, Ap, scratch, map) != nnzA) { INFO[0] = -1; return; }
+        memcpy(Ai, scratch, sizeof(int) * nnzA);
+        if (QDLDL_etree(n, Ap, Ai, iwork, Lnz, etree) != nnzL) { INFO[0] = -1; return; }
+        IW[0] = MAGIC; IW[1] = n; IW[2] = nz; IW[3] = generation; IW[4] = nnzA; IW[5] = nnzL; IW[6] = *LIW;
+    }
+    double *Ax = A + nz, *Lx = Ax + nnzA, *D = Lx + nnzL, *Dinv = D + n, *fwork = Dinv + n;
+    memset(Ax, 0, sizeof(double) * nnzA);
+    for (k = 0; k < nz; k++) Ax[map[k]] += A[k];
+    pos = QDLDL_factor(n, Ap, Ai, Ax, Lp, Li, Lx, D, Dinv, Lnz, etree, bwork, iwork, fwork);
+    if (pos < 0) { INFO[0] = -5; INFO[1] = n - 1; return; }
+    INFO[14] = n - pos; /* negative eigenvalues: the negative entries of D */
+    INFO[8] = nnzL;
+    INFO[9] = nnzL;
+    memcpy(iwork, IKEEP, sizeof(int) * n); /* for ma27cd, which is not given IKEEP */
+    bwork[0] = nz + nnzA;                  /* where Lx starts in A */
+}
+
+static void ma27c(int *N, double *A, int *IW, double *RHS) {
+    int n = *N, i;
+    int nnzA = IW[4], nnzL = IW[5];
+    int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
+    int *Lnz = etree + n, *P = Lnz + n, *bwork = P + 3 * n;
+    double *Lx = A + bwork[0], *Dinv = Lx + nnzL + n, *x = Dinv + 2 * n;
+    for (i = 0; i < n; i++) x[i] = RHS[P[i]];
+    QDLDL_solve(n, Lp, Li, Lx, Dinv, x);
+    for (i = 0; i < n; i++) RHS[P[i]] = x[i];
+}
+
+/* The Fortran-style entry points, with and without the trailing underscore IPOPT's loader may look for. */
+#define MA27ID_ARGS int *ICNTL, double *CNTL
+#define MA27AD_ARGS                                                                                                   \
+    int *N, int *NZ, const int *IRN, const int *ICN, int *IW, int *LIW, int *IKEEP, int *IW1, int *NSTEPS,           \
+        int *IFLAG, int *ICNTL, double *CNTL, int *INFO, double *OPS
+#define MA27BD_ARGS                                                                                                   \
+    int *N, int *NZ, const int *IRN, const int *ICN, double *A, int *LA, int *IW, int *LIW, int *IKEEP, int *NSTEPS, \
+        int *MAXFRT, int *IW1, int *ICNTL, double *CNTL, int *INFO
+#define MA27CD_ARGS                                                                                                   \
+    int *N, double *A, int *LA, int *IW, int *LIW, double *W, int *MAXFRT, double *RHS, int *IW1, int *NSTEPS,       \
+        int *ICNTL, int *INFO
+
+void ma27id(MA27ID_ARGS) { ma27i(ICNTL, CNTL); }
+void ma27id_(MA27ID_ARGS) { ma27i(ICNTL, CNTL); }
+void ma27ad(MA27AD_ARGS) {
+    (void)IW; (void)LIW; (void)IW1; (void)IFLAG; (void)ICNTL; (void)CNTL;
+    ma27a(N, NZ, IRN, ICN, IKEEP, NSTEPS, INFO, OPS);
+}
+void ma27ad_(MA27AD_ARGS) { ma27ad(N, NZ, IRN, ICN, IW, LIW, IKEEP, IW1, NSTEPS, IFLAG, ICNTL, CNTL, INFO, OPS); }
+void ma27bd(MA27BD_ARGS) {
+    (void)NSTEPS; (void)IW1; (void)ICNTL; (void)CNTL;
+    ma27b(N, NZ, IRN, ICN, A, LA, IW, LIW, IKEEP, MAXFRT, INFO);
+}
+void ma27bd_(MA27BD_ARGS) { ma27bd(N, NZ, IRN, ICN, A, LA, IW, LIW, IKEEP, NSTEPS, MAXFRT, IW1, ICNTL, CNTL, INFO); }
+void ma27cd(MA27CD_ARGS) {
+    (void)LA; (void)LIW; (void)W; (void)MAXFRT; (void)IW1; (void)NSTEPS; (void)ICNTL; (void)INFO;
+    ma27c(N, A, IW, RHS);
+}
+void ma27cd_(MA27CD_ARGS) { ma27cd(N, A, LA, IW, LIW, W, MAXFRT, RHS, IW1, NSTEPS, ICNTL, INFO); }

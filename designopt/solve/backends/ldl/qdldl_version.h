@@ -1,0 +1,1 @@
+#define QDLDL_VERSION "0.1.8"
