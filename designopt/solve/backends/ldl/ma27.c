@@ -39,7 +39,7 @@ static int doubles_needed(int n, int nz, int nnzA, int nnzL) { return nz + nnzA 
  * columns Ap[n+1] and sorted rows Ai, and for each triplet its slot in Ai (map[nz]). Ai needs nz + n slots while it
  * is built. Returns nnzA, or -1 when out of memory. */
 static int pattern(int n, int nz, const int *irn, const int *icn, const int *pinv, int *Ap, int *Ai, int *map) {
-    int j, k, p, total, unique = 0;
+    int j, k, p, unique = 0;
     int *next = (int *)malloc(sizeof(int) * (n + 1));
     int *order = (int *)malloc(sizeof(int) * (nz + n + 1));
     int *slot = (int *)malloc(sizeof(int) * (nz + n + 1));
@@ -55,7 +55,6 @@ static int pattern(int n, int nz, const int *irn, const int *icn, const int *pin
         Ap[(a > b ? a : b) + 1]++;
     }
     for (j = 0; j < n; j++) Ap[j + 1] += Ap[j] + 1; /* + the diagonal */
-    total = Ap[n];
     for (j = 0; j < n; j++) { rows[Ap[j]] = j; next[j] = Ap[j] + 1; }
     for (k = 0; k < nz; k++) {
         int a = pinv[irn[k] - 1], b = pinv[icn[k] - 1];
@@ -81,8 +80,23 @@ static int pattern(int n, int nz, const int *irn, const int *icn, const int *pin
     for (k = 0; k < nz; k++) map[k] = slot[map[k]];
     memcpy(Ap, counts, sizeof(int) * (n + 1));
     free(next); free(order); free(slot); free(rows); free(counts);
-    (void)total;
     return unique;
+}
+
+/* The off-diagonal pattern of both triangles of the (1-based) triplets as 0-based columns: Cp[n+1] (zeroed by the
+ * caller) and Ci[2 nz]; fill[n+1] is scratch. */
+static void adjacency(int n, int nz, const int *IRN, const int *ICN, int *Cp, int *Ci, int *fill) {
+    int j, k;
+    for (k = 0; k < nz; k++) {
+        int a = IRN[k] - 1, b = ICN[k] - 1;
+        if (a != b) { Cp[b + 1]++; Cp[a + 1]++; }
+    }
+    for (j = 0; j < n; j++) Cp[j + 1] += Cp[j];
+    memcpy(fill, Cp, sizeof(int) * (n + 1));
+    for (k = 0; k < nz; k++) {
+        int a = IRN[k] - 1, b = ICN[k] - 1;
+        if (a != b) { Ci[fill[b]++] = a; Ci[fill[a]++] = b; }
+    }
 }
 
 /* The ordering P (new -> old) changed so that no node whose diagonal is zero (a constraint row of IPOPT's KKT
@@ -107,16 +121,7 @@ static int defer_zero_pivots(int n, int nz, const int *IRN, const int *ICN, cons
         if (IRN[k] == ICN[k]) diag[IRN[k] - 1] += A[k];
     /* zero, or as good as zero: a regularised constraint row's -delta_c (1e-8 mu^0.25) is no pivot to divide by */
     for (j = 0; j < n; j++) zero[j] = fabs(diag[j]) <= WEAK;
-    for (k = 0; k < nz; k++) {
-        int a = IRN[k] - 1, b = ICN[k] - 1;
-        if (a != b) { Cp[b + 1]++; Cp[a + 1]++; }
-    }
-    for (j = 0; j < n; j++) Cp[j + 1] += Cp[j];
-    memcpy(fill, Cp, sizeof(int) * (n + 1));
-    for (k = 0; k < nz; k++) {
-        int a = IRN[k] - 1, b = ICN[k] - 1;
-        if (a != b) { Ci[fill[b]++] = a; Ci[fill[a]++] = b; }
-    }
+    adjacency(n, nz, IRN, ICN, Cp, Ci, fill);
     for (j = 0; j < n; j++) {
         int top = 0;
         stack[top++] = P[j];
@@ -162,7 +167,7 @@ static void ma27i(int *ICNTL, double *CNTL) {
 
 static void ma27a(int *N, int *NZ, const int *IRN, const int *ICN, int *IKEEP, int *NSTEPS, int *INFO, double *OPS) {
     static int generations = 0;
-    int n = *N, nz = *NZ, j, k, status, nnzA, nnzL;
+    int n = *N, nz = *NZ, j, status, nnzA, nnzL;
     double control[AMD_CONTROL], info[AMD_INFO];
     int *P = IKEEP, *Pinv = IKEEP + n;
     memset(INFO, 0, 20 * sizeof(int));
@@ -171,16 +176,7 @@ static void ma27a(int *N, int *NZ, const int *IRN, const int *ICN, int *IKEEP, i
     int *Cp = (int *)calloc(n + 1, sizeof(int)), *Ci = (int *)malloc(sizeof(int) * (2 * nz + 1));
     int *fill = (int *)malloc(sizeof(int) * (n + 1));
     if (!Cp || !Ci || !fill) { free(Cp); free(Ci); free(fill); INFO[0] = -1; return; }
-    for (k = 0; k < nz; k++) {
-        int a = IRN[k] - 1, b = ICN[k] - 1;
-        if (a != b) { Cp[b + 1]++; Cp[a + 1]++; }
-    }
-    for (j = 0; j < n; j++) Cp[j + 1] += Cp[j];
-    memcpy(fill, Cp, sizeof(int) * (n + 1));
-    for (k = 0; k < nz; k++) {
-        int a = IRN[k] - 1, b = ICN[k] - 1;
-        if (a != b) { Ci[fill[b]++] = a; Ci[fill[a]++] = b; }
-    }
+    adjacency(n, nz, IRN, ICN, Cp, Ci, fill);
     amd_defaults(control);
     status = amd_order(n, Cp, Ci, P, control, info);
     free(Cp); free(Ci); free(fill);
