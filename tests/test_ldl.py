@@ -15,6 +15,7 @@ from designopt.initial_guess import initial_guesses
 from designopt.problem import problem_from_config
 from designopt.solve.backends import ipopt as ipopt_backend
 from designopt.solve.backends import ldl
+from designopt.solve.profile import SolverProfile
 
 INT = ctypes.POINTER(ctypes.c_int)
 DOUBLE = ctypes.POINTER(ctypes.c_double)
@@ -161,7 +162,7 @@ def test_ipopt_through_the_ldl_reaches_the_known_optimum(monkeypatch):
     """The gantry's design cost alpha^2 N / (N - 1) (tests/test_transcriptions.py), with IPOPT factorising its
     KKT systems here instead of MUMPS."""
     monkeypatch.setenv("DESIGNOPT_LINEAR_SOLVER", "ldl")
-    assert ipopt_backend.linear_solver() == "ldl"
+    assert ipopt_backend.linear_solver(SolverProfile()) == "ldl"
     problem = problem_from_config(parse_config(gantry_config()))
     sol = solve_from(problem, initial_guesses(problem, 1, 0, 0.3, "constant")[0], max_iter=300)
     N = problem.toolpath.n
@@ -170,19 +171,22 @@ def test_ipopt_through_the_ldl_reaches_the_known_optimum(monkeypatch):
 
 
 def test_the_linear_solver_is_chosen_by_name(monkeypatch):
-    """``DESIGNOPT_LINEAR_SOLVER`` picks it; an unknown name is refused; ldl falls back to MUMPS without a
-    compiler."""
-    from designopt.solve.profile import SolverProfile
-
-    monkeypatch.setenv("DESIGNOPT_LINEAR_SOLVER", "mumps")
+    """A profile names it, ``DESIGNOPT_LINEAR_SOLVER`` overrides every profile; an unknown name is refused; ldl
+    falls back to MUMPS without a compiler."""
+    monkeypatch.delenv("DESIGNOPT_LINEAR_SOLVER", raising=False)
     assert "ipopt.linear_solver" not in ipopt_backend.options(SolverProfile(), 100)
-    monkeypatch.setenv("DESIGNOPT_LINEAR_SOLVER", "ldl")
-    opts = ipopt_backend.options(SolverProfile(), 1000)
+    opts = ipopt_backend.options(SolverProfile(linear_solver="ldl"), 1000)
     assert opts["ipopt.linear_solver"] == "ma27" and opts["ipopt.hsllib"] == str(ldl.library())
     assert "ipopt.mumps_pivot_order" not in opts
+    with pytest.raises(ValueError, match="linear_solver"):
+        SolverProfile(linear_solver="pardiso")
+    monkeypatch.setenv("DESIGNOPT_LINEAR_SOLVER", "mumps")
+    assert "ipopt.linear_solver" not in ipopt_backend.options(SolverProfile(linear_solver="ldl"), 100)
+    monkeypatch.setenv("DESIGNOPT_LINEAR_SOLVER", "ldl")
+    assert ipopt_backend.options(SolverProfile(), 1000)["ipopt.linear_solver"] == "ma27"
     monkeypatch.setenv("DESIGNOPT_LINEAR_SOLVER", "pardiso")
     with pytest.raises(ValueError, match="DESIGNOPT_LINEAR_SOLVER"):
-        ipopt_backend.linear_solver()
+        ipopt_backend.linear_solver(SolverProfile())
     monkeypatch.setenv("DESIGNOPT_LINEAR_SOLVER", "ldl")
     monkeypatch.setattr(ldl, "library", lambda: None)
-    assert ipopt_backend.linear_solver() == "mumps"
+    assert ipopt_backend.linear_solver(SolverProfile()) == "mumps"

@@ -350,13 +350,15 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
 
 
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
-    """Exploration within explore_max_iter, screening within screen_max_iter, refinement within the profile's
-    max_iter: a screening solve only ranks, so a stalling one must not take the full budget (design only stalls
-    there). The caps are read off the tasks each stage was given, so the test does not depend on which solve
-    reaches its cap; the screen's cap is loose enough that its optima track and a refine follows."""
+    """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter,
+    refinement within the profile's max_iter: a screening solve only ranks, so a stalling one must not take the
+    full budget (design only stalls there). The caps are read off the tasks each stage was given, so the test does
+    not depend on which solve reaches its cap; the screen's cap is loose enough that its optima track and a refine
+    follows."""
     problem = problem_from_config(parse_config(milling_12))
     search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
-                    screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300))  # rebranch: its own test
+                    screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),  # rebranch: its own test
+                    explore_linear_solver="ldl")
     done = []
 
     def execute(tasks):
@@ -371,6 +373,8 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
         assert max(s.raw.iterations for t, s in done if t.stage == stage) <= cap
     waypoints = {t.stage: t.problem.toolpath.n for t, _ in done}
     assert waypoints == {"explore": 6, "screen": 9, "refine": 12}
+    solvers = {t.stage: t.profile.linear_solver for t, _ in done}  # and the exploration its own linear solver
+    assert solvers == {"explore": "ldl", "screen": "mumps", "refine": "mumps"}
 
 
 @settings(max_examples=60, deadline=None)

@@ -12,6 +12,8 @@ from dataclasses import dataclass, replace
 
 from designopt.transcriptions.compiled import COMPILE_MODES
 
+LINEAR_SOLVERS = ("ldl", "mumps")
+
 
 @dataclass(frozen=True)
 class SolverProfile:
@@ -23,7 +25,9 @@ class SolverProfile:
     ``compile``: how the per-waypoint blocks are evaluated (``none``: interpreted; ``O0``-``O2``: C compiled at
     that level, cached on disk; ``auto``: O1 for a block evaluated at 500 points or more, a long program's, and O0
     below: `designopt.transcriptions.compiled.level`). ``observers``: names in `designopt.solve.observers.OBSERVERS`,
-    watching every iteration; an observer may stop a solve, never change it.
+    watching every iteration; an observer may stop a solve, never change it. ``linear_solver``: what factorises
+    the backend's KKT systems, a name in `LINEAR_SOLVERS` (``mumps``: MUMPS with pivoting; ``ldl``: an AMD-ordered
+    LDLᵀ without pivoting, faster and less robust, `designopt.solve.backends.ldl`).
     """
 
     backend: str = "ipopt"
@@ -33,10 +37,13 @@ class SolverProfile:
     compile: str = "auto"
     observers: tuple[str, ...] = ()
     options: tuple[tuple[str, float | int | str], ...] = ()
+    linear_solver: str = "mumps"
 
     def __post_init__(self):
         if self.compile not in COMPILE_MODES:
             raise ValueError(f"compile must be one of {COMPILE_MODES}, got {self.compile!r}")
+        if self.linear_solver not in LINEAR_SOLVERS:
+            raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {self.linear_solver!r}")
         if self.max_iter < 1 or self.time_limit <= 0:
             raise ValueError("max_iter must be >= 1 and time_limit > 0")
 
@@ -46,6 +53,10 @@ class SolverProfile:
 
     def warmed(self) -> SolverProfile:
         return replace(self, warm=True)
+
+    def solved_by(self, linear_solver: str | None) -> SolverProfile:
+        """The same profile with another linear solver (None: unchanged)."""
+        return self if linear_solver is None else replace(self, linear_solver=linear_solver)
 
     def observing(self, *names: str) -> SolverProfile:
         return replace(self, observers=tuple(dict.fromkeys((*self.observers, *names))))

@@ -37,7 +37,8 @@ class Search:
     the design held there (`strategies.continuation`). ``structure_neighbours``: after the strategy, one more
     start per problem from each neighbouring structure's better design (`strategies.neighbours`; problems whose
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
-    solver profile.
+    solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None:
+    the profile's; `SolverProfile.linear_solver`).
     """
 
     strategy: str = "coarse_to_fine"
@@ -57,6 +58,7 @@ class Search:
     hold_degenerate: bool = True
     structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
+    explore_linear_solver: str | None = None
 
     @property
     def rebranch_starts(self) -> int:
@@ -68,6 +70,8 @@ class Search:
         held = "; a solve stalled on a degenerate design is finished held" if self.hold_degenerate else ""
         options = ", ".join(f"{k.removeprefix('ipopt.')} {v}" for k, v in self.profile.options)
         solver = f"; IPOPT options {options}" if options else ""  # what the profile sets beyond the backend's own
+        if self.profile.linear_solver != "mumps":
+            solver += f"; KKT systems by {self.profile.linear_solver}"
         cap = f"<= {self.profile.max_iter} iterations"
         drawn = {"perturb": "", "box": " drawn from the task's box",
                  "mixed": " (every other one drawn from the task's box)"}[self.spread]
@@ -78,9 +82,11 @@ class Search:
                   f"(<= {self.screen_max_iter} iterations, if the path has more)" if self.screen_waypoints else "")
         again = (f", the best {self.rebranch} distinct restarted {self.rebranch_starts} times each on a new joint "
                  f"branch" if self.rebranch else "")
+        kkt = self.explore_linear_solver or self.profile.linear_solver
+        kkt = f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
-                f"{self.explore_max_iter} iterations){again}{screen}, the best {self.refine} distinct optima refined "
-                f"on the full path ({cap}){held}{solver}")
+                f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
+                f"refined on the full path ({cap}){held}{solver}")
 
 
 # IPOPT options for design spaces whose tracking Jacobian goes rank-deficient on the way: a structure with fewer

@@ -22,6 +22,7 @@ import numpy as np
 import designopt.solve.backends.ldl as ldl
 from designopt.solve.backends.base import Outcome
 from designopt.solve.observers import Bound, Iterate, make_observers
+from designopt.solve.profile import LINEAR_SOLVERS
 from designopt.transcriptions.nlp import NLP
 
 # no_nlp_grad: nlpsol otherwise builds, at set-up, the reverse derivative of the whole NLP ("nlp_grad"), which it
@@ -44,16 +45,11 @@ OBSERVE_EVERY = 5
 # variables), 0.90 on the main job (80, 984), 1.02 on the pocket cell, but 1.15 on the exploration problem
 # (10, ~150 variables; 24 starts).
 METIS_FROM = 400
-# The KKT systems' linear solver: "ldl" (`designopt.solve.backends.ldl`: AMD + QDLDL, loaded as IPOPT's ma27) or
-# "mumps". `DESIGNOPT_LINEAR_SOLVER` overrides it (to compare the two; docs/benchmarks.md).
-LINEAR_SOLVER = "mumps"
-LINEAR_SOLVERS = ("ldl", "mumps")
-
-
-def linear_solver() -> str:
-    """The linear solver of this process's solves (`LINEAR_SOLVER`, or the environment's
-    ``DESIGNOPT_LINEAR_SOLVER``): "ldl" only when its library can be built, else "mumps"."""
-    name = os.environ.get("DESIGNOPT_LINEAR_SOLVER", "").strip().lower() or LINEAR_SOLVER
+def linear_solver(profile) -> str:
+    """The linear solver of a profile's solves: the profile's ``linear_solver``, unless the environment's
+    ``DESIGNOPT_LINEAR_SOLVER`` names one for every solve of the process (to compare the two; docs/benchmarks.md);
+    "ldl" only when its library can be built, else "mumps"."""
+    name = os.environ.get("DESIGNOPT_LINEAR_SOLVER", "").strip().lower() or profile.linear_solver
     if name not in LINEAR_SOLVERS:
         raise ValueError(f"DESIGNOPT_LINEAR_SOLVER must be one of {LINEAR_SOLVERS}, got {name!r}")
     return "ldl" if name == "ldl" and ldl.library() is not None else "mumps"
@@ -62,7 +58,7 @@ def linear_solver() -> str:
 def options(profile, n_variables: int = 0) -> dict:
     """nlpsol options of a profile for an NLP of ``n_variables`` (without the derivatives and the observers)."""
     opts = {**BASE_OPTIONS, "ipopt.max_iter": int(profile.max_iter), "ipopt.max_wall_time": float(profile.time_limit)}
-    if linear_solver() == "ldl":
+    if linear_solver(profile) == "ldl":
         opts |= {"ipopt.linear_solver": "ma27", "ipopt.hsllib": str(ldl.library())}
     elif n_variables >= METIS_FROM:
         opts["ipopt.mumps_pivot_order"] = 5

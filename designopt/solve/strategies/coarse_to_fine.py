@@ -67,8 +67,8 @@ def plan(jobs, search):
     explore = []
     for job in jobs:
         coarse = coarse_problem(job.problem, search.explore_waypoints)
-        explore += seeded_tasks(job, "explore", coarse, search.profile.capped(search.explore_max_iter), search,
-                                search.starts)
+        profile = search.profile.capped(search.explore_max_iter).solved_by(search.explore_linear_solver)
+        explore += seeded_tasks(job, "explore", coarse, profile, search, search.starts)
     explored = by_job(jobs, (yield explore))
     if search.rebranch:
         again = by_job(jobs, (yield rebranched_tasks(explored, search)))
