@@ -63,7 +63,7 @@ NEIGHBOURHOOD_BUDGET = 300  # module assignments the neighbourhood search may sc
 NEIGHBOURHOOD_SAMPLE = 1 / 6  # share of the budget: spread assignments screened with the rounded one, to start from
 NEIGHBOURHOOD_REFINE = 8  # best distinct screening optima re-solved on the full path
 SCREEN_WAYPOINTS = 10  # the screening's sampling of the path
-REFINE_STARTS = 160  # coarse starts of each best screened assignment's full-path search (the default search has 80)
+REFINE_STARTS = 160  # coarse starts of each best screened assignment's full-path search
 # w_lin (1/m^2) and w_ang of the similarity distance (SPEC §3)
 LINEAR_WEIGHT, ANGULAR_WEIGHT = 1.0, 0.25
 
@@ -229,12 +229,13 @@ def module_screen(search: Search) -> Search:
 def module_refine(search: Search) -> Search:
     """How the neighbourhood search solves its best screened assignments on the full path: the default search
     (coarse to fine; the search's seed) with `REFINE_STARTS` coarse starts, moved until they reach the path (no
-    second round on new joint branches: not measured on modular robots), as the enumeration that found the best
-    modular robot known solved its candidates (`benchmarks/modular_enumeration.py`).
+    second round on new joint branches, and MUMPS in the exploration too: neither measured on modular robots), as
+    the enumeration that found the best modular robot known solved its candidates (`benchmarks/modular_enumeration.py`).
     The config's own search (the ``paper`` preset's 4 cold starts in the shipped config) lost 1.3-1.5x on
-    assignments it shares with the enumeration; the default's 80 starts missed an assignment's own best on 3 of
+    assignments it shares with the enumeration; 80 coarse starts missed an assignment's own best on 3 of
     7 evaluation seeds (1.24-1.41x where 160 starts reach 1.05x: docs/decisions.md)."""
-    return preset("default", seed=search.seed, init="reach", starts=REFINE_STARTS, rebranch=0)
+    return preset("default", seed=search.seed, init="reach", starts=REFINE_STARTS, rebranch=0,
+                  explore_linear_solver=None)
 
 
 def _module_search(setup, base, catalogue, placement, rounded, modular, budget, refine=NEIGHBOURHOOD_REFINE):

@@ -110,7 +110,11 @@ PRESETS: dict[str, Search] = {
     # than six joints or prismatic ones)
     "quick": Search(starts=40, rebranch=0, refine=2,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
-    "default": Search(),
+    # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
+    # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against
+    # 80 starts and MUMPS: the main job 8 -> 15 within 1.10x of the best design known, physical stiffness 6 -> 10,
+    # the circle 3 -> 3, at 1.45-1.6x the wall (docs/benchmarks.md, "Search"; docs/decisions.md, 2026-11-26)
+    "default": Search(starts=160, explore_linear_solver="ldl"),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
