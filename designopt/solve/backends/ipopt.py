@@ -1,5 +1,6 @@
 """IPOPT through CasADi's ``nlpsol``: exact Hessian, constraint Jacobian and gradient (from the transcription's
-per-waypoint blocks when it has them: `NLP.derivatives`), MUMPS (METIS ordering from ``METIS_FROM`` variables), quiet.
+per-waypoint blocks when it has them: `NLP.derivatives`), the KKT systems factorised by the profile's linear solver
+(MUMPS, METIS ordering from ``METIS_FROM`` variables; or the LDLᵀ of `designopt.solve.backends.ldl`), quiet.
 
 A profile's cap and time limit become ``max_iter`` and ``max_wall_time``; a warm profile starts the barrier at
 1e-4 with bound push and fraction 1e-6 instead of 0.1 and 1e-2: with IPOPT's defaults a solve started at the best
