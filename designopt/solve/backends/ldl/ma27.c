@@ -13,7 +13,7 @@
  *   IW: header[HDR] | Ap[n+1] Ai[nnzA] (the permuted upper triangle, every diagonal present) | Lp[n+1] Li[nnzL] |
  *       etree[n] Lnz[n] | iwork[3n] (QDLDL's; after a factorisation its first n hold P for ma27cd) |
  *       bwork[n] (QDLDL's; after a factorisation bwork[0] holds the offset of Lx in A) | map[nz] (triplet ->
- *       Ai slot) | diag[n] | scratch for building the pattern [2 nz + 2 n]
+ *       Ai slot) | scratch for building the pattern [2 nz + 2 n]
  *   A: the triplets' values[nz] (written by IPOPT) | Ax[nnzA] | Lx[nnzL] | D[n] | Dinv[n] | fwork[n] | x[n]
  * The pattern of IW is built at the first factorisation of an analysis and reused by the next ones (header:
  * MAGIC, n, nz, generation, nnzL, LIW), so a factorisation is a scatter of the values and QDLDL's numeric pass.
@@ -30,7 +30,7 @@
 #define WEAK 1e-7 /* a diagonal entry this small counts as zero for the ordering (IPOPT's delta_c <= 1e-8) */
 
 static int ints_needed(int n, int nz, int nnzA, int nnzL) {
-    return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + 3 * n + n + nz + n + (2 * nz + 2 * n);
+    return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + 3 * n + n + nz + (2 * nz + 2 * n);
 }
 
 static int doubles_needed(int n, int nz, int nnzA, int nnzL) { return nz + nnzA + nnzL + 4 * n; }
@@ -212,8 +212,8 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
     if (*LIW < ineed) { INFO[0] = -3; INFO[1] = ineed; return; }
     if (*LA < dneed) { INFO[0] = -4; INFO[1] = dneed; return; }
     int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
-    int *Lnz = etree + n, *iwork = Lnz + n, *bwork = iwork + 3 * n, *map = bwork + n, *diag = map + nz;
-    int *scratch = diag + n; /* 2 nz + 2 n */
+    int *Lnz = etree + n, *iwork = Lnz + n, *bwork = iwork + 3 * n, *map = bwork + n;
+    int *scratch = map + nz; /* 2 nz + 2 n */
     int cached = generation > 0 && IW[0] == MAGIC && IW[1] == n && IW[2] == nz && IW[3] == generation &&
                  IW[4] == nnzA && IW[5] == nnzL && IW[6] == *LIW;
     if (!cached) {
