@@ -1,11 +1,15 @@
-"""Metrics of a candidate solution, computed one way (numpy) for every method.
+"""Metrics of a candidate solution, computed one way for every method.
 
 Whatever transcription produced (q_d, Q), the design cost, the tracking errors and the joint steps
-reported are computed here, so TO and FK compare on one number.
+reported are computed here, so TO and FK compare on one number. The per-waypoint quantities come from the cost
+definitions of `designopt.costs` (the same ones the NLPs are built from), evaluated numerically by one CasADi
+function of the problem mapped over the waypoints (`waypoint_metrics`); the sums, norms and maxima are numpy's.
 """
 
 from __future__ import annotations
 
+import functools
+import pickle
 from dataclasses import dataclass
 
 import numpy as np
@@ -72,21 +76,47 @@ def trajectory_clearance(problem: DesignProblem, q_d: np.ndarray, trajectory):
     return min_clearance(problem.chain, problem.cell, q_d, configurations, indices)
 
 
+def waypoint_metrics(problem: DesignProblem, n: int):
+    """(Q [n_moving x n], q_d [n_design], S_W [3 x n], F_W [3 x n]) -> (deformation L_d [1 x n], position error
+    p_W - s_W [3 x n, m], axis error z_W - z* [3 x n], path point in B [3 x n, m], each of the problem's waypoint
+    costs before its weight [n_costs x n]) at ``n`` waypoints: a CasADi function of the states
+    `DesignProblem.waypoint` gives (column k: waypoint k; S_W, F_W the path points [m] and forces [N] in W), built
+    once per chain, stiffness, deflection model, waypoint costs and n in a process. A numpy walk of the chain per
+    waypoint cost ~1.4 ms a waypoint, a tenth of an exploration solve's time (benchmarks/evaluate_speed.py)."""
+    key = pickle.dumps((problem.chain, problem.k_inv, problem.deflection, problem.waypoint_costs))
+    return _waypoint_metrics(key, n)
+
+
+@functools.lru_cache(maxsize=32)
+def _waypoint_metrics(key: bytes, n: int):
+    import casadi as ca
+
+    chain, k_inv, deflection, waypoint_costs = pickle.loads(key)
+    q, q_d = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design)
+    s_W, f_W = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3)
+    w = costs.waypoint(chain, q, q_d, s_W, f_W, k_inv, deflection)
+    deform = deformation_term(w)
+    r_p, r_z = tracking_residual(w)
+    s_B = w.T_BW[:3, :3] @ s_W + w.T_BW[:3, 3]
+    values = [deform if c.fn is deformation_term else c.fn(w) for c in waypoint_costs]
+    one = ca.Function("waypoint_metrics", [q, q_d, s_W, f_W],
+                      [deform, r_p, r_z, s_B, ca.vertcat(*values) if values else ca.SX(0, 1)])
+    return one.map(n)
+
+
 def evaluate(problem: DesignProblem, q_d: np.ndarray, trajectory) -> Metrics:
     """Evaluate a design q_d (n_d) and a joint trajectory (`designopt.transcriptions.trajectory`; its knots are
     the waypoints) on the problem's toolpath; the clearance is checked at its collocation points too."""
     chain, tp = problem.chain, problem.toolpath
     q_d = np.asarray(q_d, dtype=float)
     Q = np.asarray(trajectory.Q, dtype=float)
-    states = [problem.waypoint(Q[k], q_d, tp.points_W[k], tp.force_W[k]) for k in range(tp.n)]
-    deform = np.array([deformation_term(w) for w in states])
-    residuals = [tracking_residual(w) for w in states]
-    pos_err = np.array([np.linalg.norm(r_p) for r_p, _ in residuals])
-    axis_err = np.array([np.linalg.norm(r_z) for _, r_z in residuals])
-    s_B = [w.T_BW[:3, :3] @ w.s_W + w.T_BW[:3, 3] for w in states]
+    out = waypoint_metrics(problem, tp.n)(Q.T, q_d, np.asarray(tp.points_W, float).T,
+                                          np.asarray(tp.force_W, float).T)
+    deform, r_p, r_z, s_B, per_cost = (np.array(o, dtype=float) for o in out)
+    deform = deform.ravel()
+    pos_err, axis_err = np.linalg.norm(r_p, axis=0), np.linalg.norm(r_z, axis=0)
     weights, tracked = tp.weights, tp.is_tracked
-    values = {c.name: float(sum(wk * c.fn(w) for wk, w in zip(weights, states, strict=True)))
-              for c in problem.waypoint_costs}
+    values = {c.name: float(np.sum(weights * per_cost[i])) for i, c in enumerate(problem.waypoint_costs)}
     values |= {c.name: float(c.fn(chain, q_d)) for c in problem.design_costs}
     regularization = sum(c.weight * values[c.name] for c in problem.design_costs if c.name == "regularization")
     # rapids (untracked waypoints) may leave the path: errors count where the tool cuts
@@ -101,7 +131,7 @@ def evaluate(problem: DesignProblem, q_d: np.ndarray, trajectory) -> Metrics:
         deformation=deform,
         position_error=pos_err,
         axis_error=axis_err,
-        min_standoff=float(min(np.hypot(s[0], s[1]) for s in s_B)),
+        min_standoff=float(np.min(np.hypot(s_B[0], s_B[1]))),
         costs=tuple(values.items()),
         clearance=trajectory_clearance(problem, q_d, trajectory) if problem.cell is not None else None,
     )

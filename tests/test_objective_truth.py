@@ -242,13 +242,25 @@ def test_optimizer_and_evaluation_agree_with_reference_at_random_points(deflecti
         np.testing.assert_allclose(c[:3], p_ref - s_W, atol=1e-12)
         np.testing.assert_allclose(c[3:6], z_ref, atol=1e-12)
         assert float(phi) / h == pytest.approx(L_ref, rel=1e-10)
-        # The evaluation (the reported numbers) at a one-waypoint path through the same point.
-        tp = toolpaths.Toolpath("point", np.array([0.0, 1.0]), np.tile(s_W, (2, 1)), np.zeros((2, 3)),
-                                np.tile(f_W, (2, 1)))
-        m = evaluate(replace(problem, toolpath=tp), q_d, PiecewiseLinear(tp.t, np.tile(q, (2, 1))))
-        assert m.deformation[0] == pytest.approx(L_ref, rel=1e-10)
-        assert m.position_error[0] == pytest.approx(np.linalg.norm(p_ref - s_W), rel=1e-9, abs=1e-12)
-        assert m.axis_error[0] == pytest.approx(np.linalg.norm(z_ref - [0, 0, -1]), rel=1e-9, abs=1e-12)
+        # The evaluation (the reported numbers) on a path through this point and three others, each with its own
+        # joints and force: every waypoint's numbers where they belong, the sums weighted by the path's dt.
+        S, F = np.vstack([s_W, rng.normal(size=(3, 3))]), np.vstack([f_W, rng.normal(size=(3, 3))])
+        Q = np.vstack([q, rng.uniform(-2, 2, (3, chain.n_moving))])
+        tp = toolpaths.Toolpath("points", np.linspace(0.0, 1.0, 4), S, np.zeros((4, 3)), F)
+        m = evaluate(replace(problem, toolpath=tp), q_d, PiecewiseLinear(tp.t, Q))
+        refs = [ref_waypoint(structure, dh, placement, Q[k], S[k], F[k], [3.0, 0.2, 3, 3, 0.2, 3], deflection)
+                for k in range(4)]
+        assert refs[0][2] == L_ref
+        np.testing.assert_allclose(m.deformation, [r[2] for r in refs], rtol=1e-10)
+        np.testing.assert_allclose(m.position_error, [np.linalg.norm(r[0] - S[k]) for k, r in enumerate(refs)],
+                                   rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(m.axis_error, [np.linalg.norm(r[1] - [0, 0, -1]) for r in refs], rtol=1e-9,
+                                   atol=1e-12)
+        assert m.design_cost == pytest.approx(sum(w * r[2] for w, r in zip(tp.weights, refs, strict=True)),
+                                              rel=1e-10)
+        T_BW = ref_placement(*placement)  # the path's points in B: the stand-off is their least distance from z_B
+        assert m.min_standoff == pytest.approx(min(np.hypot(*(T_BW[:3, :3] @ s + T_BW[:3, 3])[:2]) for s in S),
+                                               rel=1e-10)
 
 
 def test_symbolic_deformation_uses_inverse_stiffness():

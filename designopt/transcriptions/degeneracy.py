@@ -14,14 +14,16 @@ solve that sits there, and `designopt.solve.strategies.continuation` finishes it
 
 from __future__ import annotations
 
+import functools
+import pickle
 from dataclasses import replace
 
 import casadi as ca
 import numpy as np
 
+from designopt.costs import waypoint
 from designopt.kinematics.joints import Role
 from designopt.problem import DesignProblem
-from designopt.transcriptions.base import waypoint_function
 
 POSITION_ROWS, AXIS_ROWS = (0, 1, 2), (3, 4, 5)  # the hard tracking rows: p_W - s_W, then z_W
 
@@ -38,11 +40,17 @@ def _sample(joints, rng) -> np.ndarray:
 
 def tracking_jacobian(problem: DesignProblem) -> ca.Function:
     """(q, q_d) -> the 6 x n_moving Jacobian d(p_W, z_W)/dq of the hard tracking rows (tool position in W [m],
-    tool axis in W) with respect to the moving joints. Neither depends on the waypoint, only their targets do."""
-    chain = problem.chain
+    tool axis in W) with respect to the moving joints. Neither depends on the waypoint, only their targets do.
+    Built once per chain in a process (every unconverged solve of a search asks, `held_at_multiples_of_pi`)."""
+    return _tracking_jacobian(pickle.dumps(problem.chain))
+
+
+@functools.lru_cache(maxsize=16)
+def _tracking_jacobian(chain_key: bytes) -> ca.Function:
+    chain = pickle.loads(chain_key)
     q, q_d = ca.SX.sym("q", chain.n_moving), ca.SX.sym("q_d", chain.n_design)
-    p_W, z_W, _, _ = waypoint_function(problem)(q, q_d, ca.SX.zeros(3), ca.SX.zeros(3))
-    return ca.Function("drows_dq", [q, q_d], [ca.jacobian(ca.vertcat(p_W, z_W), q)])
+    w = waypoint(chain, q, q_d, ca.SX.zeros(3), ca.SX.zeros(3), None, "full")  # p_W, z_W: the chain's alone
+    return ca.Function("drows_dq", [q, q_d], [ca.jacobian(ca.vertcat(w.p_W, w.z_W), q)])
 
 
 def q_independent_rows(problem: DesignProblem, samples: int = 4, seed: int = 0, tol: float = 1e-9,
