@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from designopt.solve import cluster_designs, design_distance
 from designopt.tables import best_so_far
@@ -22,6 +24,26 @@ def test_cluster_designs_finds_the_distinct_optima():
     labels = cluster_designs(designs, costs, angle, tol=0.02)
     # cheapest first: [0.9, 1.0] is optimum 0, the wrapped pair 1, the 0.5 m pair 2
     assert list(labels) == [1, 2, 1, 2, 0]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 4), st.integers(1, 40), st.floats(0.01, 2.0), st.integers(0, 2**32 - 1))
+def test_cluster_designs_is_the_pairwise_rule(n_design, n, tol, seed):
+    """Each design, cheapest first, joins the first cluster whose representative is within tol by `design_distance`
+    (angles wrapped), else starts one: the rule written out pair by pair, on designs that fall near one another."""
+    rng = np.random.default_rng(seed)
+    angle = rng.random(n_design) < 0.5
+    centres = rng.uniform(-4, 4, (3, n_design))
+    designs = centres[rng.integers(0, 3, n)] + rng.normal(scale=tol, size=(n, n_design))
+    costs = rng.choice([1.0, 2.0, 3.0], n) if seed % 2 else rng.random(n)  # ties: the stable order decides
+    expected, leaders = np.empty(n, dtype=int), []
+    for i in np.argsort(costs, kind="stable"):
+        k = next((k for k, j in enumerate(leaders) if design_distance(designs[i], designs[j], angle) <= tol), None)
+        if k is None:
+            k = len(leaders)
+            leaders.append(i)
+        expected[i] = k
+    assert list(cluster_designs(designs, costs, angle, tol)) == list(expected)
 
 
 def test_best_so_far_ignores_solves_that_do_not_track():

@@ -17,17 +17,22 @@ def design_distance(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> float:
 
 def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, tol: float = 0.02) -> np.ndarray:
     """Label each design with its local optimum: in order of cost, a design joins the first (cheaper) cluster
-    whose representative lies within ``tol`` (m or rad) in every design joint, else starts a new one."""
+    whose representative lies within ``tol`` (m or rad) in every design joint (`design_distance`), else starts a
+    new one. Each design is compared with every representative at once: a search's 320 coarse optima, most of
+    them distinct, took ~50,000 pairwise calls (0.4 s) between two of its stages, while the workers waited."""
+    designs = np.asarray(designs, float).reshape(len(costs), -1)
     order = np.argsort(costs, kind="stable")
-    labels, leaders = np.empty(len(costs), dtype=int), []
+    labels, leaders, n = np.empty(len(costs), dtype=int), np.empty_like(designs), 0
     for i in order:
-        for k, j in enumerate(leaders):
-            if design_distance(designs[i], designs[j], angle) <= tol:
-                labels[i] = k
-                break
-        else:
-            labels[i] = len(leaders)
-            leaders.append(i)
+        if n:
+            d = designs[i] - leaders[:n]
+            d = np.where(angle, np.arctan2(np.sin(d), np.cos(d)), d)
+            near = np.flatnonzero(np.max(np.abs(d), axis=1, initial=0.0) <= tol)
+            if near.size:
+                labels[i] = near[0]
+                continue
+        labels[i], leaders[n] = n, designs[i]
+        n += 1
     return labels
 
 
