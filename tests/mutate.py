@@ -100,6 +100,10 @@ MUTATIONS = [
     # the search (issue 11)
     Mutation("search refines the most expensive coarse optima", "designopt/solve/optima.py",
              "for k in np.argsort(costs, kind=\"stable\"):", "for k in np.argsort(-costs, kind=\"stable\"):"),
+    Mutation("distinct optima: a design joins the last cluster near it, not the first", "designopt/solve/optima.py",
+             "labels[i] = near[0]", "labels[i] = near[-1]", ("tests/test_tables.py",)),
+    Mutation("the evaluation reads the path's forces as its points", "designopt/evaluation.py",
+             "q_d, np.asarray(tp.points_W, float).T,", "q_d, np.asarray(tp.force_W, float).T,"),
     Mutation("lifted start drops the coarse design", "designopt/solve/starts.py",
              "q_d = np.asarray(solution.raw.q_d, float)", "q_d = problem.chain.design_values"),
     Mutation("a lifted start's waypoints left where the coarse trajectory puts them", "designopt/solve/starts.py",
