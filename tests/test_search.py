@@ -352,14 +352,14 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
 
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter,
-    refinement within the profile's max_iter: a screening solve only ranks, so a stalling one must not take the
+    refinement within the profile's max_iter (and from refine_mu_init): a screening solve only ranks, so a stalling one must not take the
     full budget (design only stalls there). The caps are read off the tasks each stage was given, so the test does
     not depend on which solve reaches its cap; the screen's cap is loose enough that its optima track and a refine
     follows."""
     problem = problem_from_config(parse_config(milling_12))
     search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
                     screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),  # rebranch: its own test
-                    explore_linear_solver="ldl")
+                    explore_linear_solver="ldl", refine_mu_init=1e-6)
     done = []
 
     def execute(tasks):
@@ -376,6 +376,9 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     assert waypoints == {"explore": 6, "screen": 9, "refine": 12}
     solvers = {t.stage: t.profile.linear_solver for t, _ in done}  # and the exploration its own linear solver
     assert solvers == {"explore": "ldl", "screen": "mumps", "refine": "mumps"}
+    barriers = {t.stage: dict(t.profile.options).get("ipopt.mu_init") for t, _ in done}  # the refine's own barrier
+    assert barriers == {"explore": None, "screen": None, "refine": 1e-6}
+    assert all(t.profile.warm for t, _ in done if t.stage != "explore")
 
 
 @settings(max_examples=60, deadline=None)

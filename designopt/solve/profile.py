@@ -60,3 +60,8 @@ class SolverProfile:
 
     def observing(self, *names: str) -> SolverProfile:
         return replace(self, observers=tuple(dict.fromkeys((*self.observers, *names))))
+
+    def with_options(self, **options: float | int | str) -> SolverProfile:
+        """The same profile with these backend options set (a name already set is replaced), e.g.
+        ``with_options(**{"ipopt.mu_init": 1e-6})``."""
+        return replace(self, options=tuple({**dict(self.options), **options}.items()))

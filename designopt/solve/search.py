@@ -38,7 +38,9 @@ class Search:
     start per problem from each neighbouring structure's better design (`strategies.neighbours`; problems whose
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
     solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None:
-    the profile's; `SolverProfile.linear_solver`).
+    the profile's; `SolverProfile.linear_solver`). ``refine_mu_init``: the barrier parameter the refine's warm
+    solves start from (IPOPT's ``mu_init``; None: the warm start's own, 1e-4, `designopt.solve.backends.ipopt`): a
+    smaller one keeps a refine in the basin its screened start is in.
     """
 
     strategy: str = "coarse_to_fine"
@@ -59,6 +61,7 @@ class Search:
     structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
     explore_linear_solver: str | None = None
+    refine_mu_init: float | None = None
 
     @property
     def rebranch_starts(self) -> int:
@@ -84,9 +87,10 @@ class Search:
                  f"branch" if self.rebranch else "")
         kkt = self.explore_linear_solver or self.profile.linear_solver
         kkt = f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
+        barrier = f", barrier from {self.refine_mu_init:g}" if self.refine_mu_init is not None else ""
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
-                f"refined on the full path ({cap}){held}{solver}")
+                f"refined on the full path ({cap}{barrier}){held}{solver}")
 
 
 # IPOPT options for design spaces whose tracking Jacobian goes rank-deficient on the way: a structure with fewer

@@ -35,13 +35,18 @@ def coarse_problem(problem: DesignProblem, waypoints: int) -> DesignProblem:
     return replace(problem, toolpath=subsample(problem.toolpath, waypoints))
 
 
-def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, search, max_iter: int | None = None):
+def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, search, max_iter: int | None = None,
+                 mu_init: float | None = None):
     """For every job, its ``count`` best distinct solutions lifted to ``waypoints`` (None: the full path), each
-    solved warm within ``max_iter`` iterations (None: the profile's own cap)."""
+    solved warm within ``max_iter`` iterations (None: the profile's own cap), from barrier parameter ``mu_init``
+    (None: the warm start's own)."""
+    warm = search.profile.warmed().capped(max_iter)
+    if mu_init is not None:
+        warm = warm.with_options(**{"ipopt.mu_init": mu_init})
     tasks = []
     for job, done in zip(jobs, found, strict=True):
         problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
-        profile, continuation = solve_setup(job, search, search.profile.warmed().capped(max_iter))
+        profile, continuation = solve_setup(job, search, warm)
         for i in distinct_best([sol for _, sol in done], count, search.distinct):
             tasks.append(Task(job.case, stage, problem, job.transcription, profile, Lifted(done[i][1]), continuation))
     return tasks
@@ -81,5 +86,6 @@ def plan(jobs, search):
                              search, search.screen_max_iter)
         found = dict(zip(screened, by_job(sub, (yield tasks)), strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
-    final = by_job(jobs, (yield lifted_tasks(jobs, candidates, search.refine, "refine", None, search)))
+    final = by_job(jobs, (yield lifted_tasks(jobs, candidates, search.refine, "refine", None, search,
+                                             mu_init=search.refine_mu_init)))
     return [Searched(job, e, f) for job, e, f in zip(jobs, explored, final, strict=True)]
