@@ -113,6 +113,12 @@ def main() -> None:
         table[name] = [cost / args.reference if tracks else np.inf for cost, tracks in done]
         columns.append(name)
     table["better of all"] = table[columns].min(axis=1)
+    answers = table.groupby("run")[[*columns, "better of all"]].min().rename(columns={"tracked": "as run"})
+    print("\n" + answers.to_string(float_format=lambda v: f"{v:.3f}"))
+    for name in columns[1:]:
+        better = int((answers[name] < 0.995 * answers["as run"]).sum())
+        worse = int((answers[name] > 1.005 * answers["as run"]).sum())
+        print(f"{name}: runs better / worse than as run (by more than 0.5 %): {better} / {worse}")
     print("\nthe answers (each run's best tracking refine) / best known: best / median / p90 / worst")
     for name in ("tracked", *columns[1:], "better of all"):
         label = "as run" if name == "tracked" else name

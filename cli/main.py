@@ -103,6 +103,7 @@ def run(
 
     Exit code 0 when a design tracks the path, 3 when none does, 2 for bad input."""
     from designopt.experiments.run import run_experiment
+    from designopt.tables import COARSE_STAGES
 
     cfg = load(config)
     with Bar(f"{cfg.name}: solving") as bar:
@@ -110,12 +111,13 @@ def run(
     problem = result.problem
     if result.explored:
         # every coarse stage (explore on the coarsest path, screen on a finer one) with how many of its solves track
-        coarse = result.summary[~result.summary["stage"].isin(["refine", "start"])]
+        coarse = result.summary[result.summary["stage"].isin(COARSE_STAGES)]
         stages = [(stage, len(rows), int(rows["tracks"].astype(str).str.lower().eq("true").sum()))
                   for stage, rows in coarse.groupby("stage", sort=False)]
         parts = [f"{stage} {solves} solves ({tracking} track)" for stage, solves, tracking in stages]
         out.print(f"explored: {', '.join(parts)}; {len(result.solution_set)} distinct optima; "
-                  f"{len(result.solutions)} refined on the full path ({problem.toolpath.n} waypoints)"
+                  f"{len({s.raw.seed for s in result.solutions})} refined on the full path ({problem.toolpath.n} "
+                  f"waypoints, {len(result.solutions)} solves)"
                   + ("" if result.solutions or not stages or stages[-1][2] else
                      f" -- nothing tracked in the {stages[-1][0]} stage, so nothing was refined: try more starts "
                      "(search.starts), another start placement or search.preset paper (starts on the full path)"))

@@ -56,7 +56,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     # a config without `search` gets the library's default search; its three keys each change what runs
     assert search_from_config(parse_config({})) == PRESETS["default"]
-    assert PRESETS["default"] == Search(starts=160, screen=24, explore_linear_solver="ldl")
+    assert PRESETS["default"] == Search(starts=160, screen=24, explore_linear_solver="ldl", refine_mu_init=(None, 1e-6))
     for name in PRESETS:
         assert search_from_config(parse_config({"search": {"preset": name}})) == PRESETS[name]
     changed = search_from_config(parse_config({"search": {"preset": "paper", "seed": 7, "starts": 3}}))
@@ -352,14 +352,14 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
 
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter,
-    refinement within the profile's max_iter (and from refine_mu_init): a screening solve only ranks, so a stalling one must not take the
-    full budget (design only stalls there). The caps are read off the tasks each stage was given, so the test does
-    not depend on which solve reaches its cap; the screen's cap is loose enough that its optima track and a refine
-    follows."""
+    refinement within the profile's max_iter (once from each barrier of refine_mu_init): a screening solve only
+    ranks, so a stalling one must not take the full budget (design only stalls there). The caps are read off the
+    tasks each stage was given, so the test does not depend on which solve reaches its cap; the screen's cap is
+    loose enough that its optima track and a refine follows."""
     problem = problem_from_config(parse_config(milling_12))
     search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
                     screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),  # rebranch: its own test
-                    explore_linear_solver="ldl", refine_mu_init=1e-6)
+                    explore_linear_solver="ldl", refine_mu_init=(None, 1e-6))
     done = []
 
     def execute(tasks):
@@ -367,17 +367,20 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
         return done[-len(tasks):]
 
     run_search([Job("", problem)], search, execute)
-    caps = {"explore": 100, "screen": 150, "refine": 300}
+    caps = {"explore": 100, "screen": 150, "refine": 300, "refine2": 300}
     assert {t.stage for t, _ in done} == set(caps)
     for stage, cap in caps.items():
         assert all(t.profile.max_iter == cap for t, _ in done if t.stage == stage)
         assert max(s.raw.iterations for t, s in done if t.stage == stage) <= cap
     waypoints = {t.stage: t.problem.toolpath.n for t, _ in done}
-    assert waypoints == {"explore": 6, "screen": 9, "refine": 12}
+    assert waypoints == {"explore": 6, "screen": 9, "refine": 12, "refine2": 12}
     solvers = {t.stage: t.profile.linear_solver for t, _ in done}  # and the exploration its own linear solver
-    assert solvers == {"explore": "ldl", "screen": "mumps", "refine": "mumps"}
-    barriers = {t.stage: dict(t.profile.options).get("ipopt.mu_init") for t, _ in done}  # the refine's own barrier
-    assert barriers == {"explore": None, "screen": None, "refine": 1e-6}
+    assert solvers == {"explore": "ldl", "screen": "mumps", "refine": "mumps", "refine2": "mumps"}
+    # each candidate refined once per barrier: the warm start's own, then 1e-6
+    barriers = {t.stage: dict(t.profile.options).get("ipopt.mu_init") for t, _ in done}
+    assert barriers == {"explore": None, "screen": None, "refine": None, "refine2": 1e-6}
+    starts = {stage: sorted(t.seed for t, _ in done if t.stage == stage) for stage in ("refine", "refine2")}
+    assert starts["refine"] == starts["refine2"] and len(starts["refine"]) == 1
     assert all(t.profile.warm for t, _ in done if t.stage != "explore")
 
 

@@ -23,7 +23,10 @@ def searched_set(searched: Searched) -> pd.DataFrame:
     if not searched.explore:
         return solution_set([sol for _, sol in searched.final])
     table = solution_set([sol for _, sol in searched.explore])
-    refined = {sol.raw.seed: sol.metrics.design_cost for _, sol in searched.final if sol.metrics.tracks}
+    refined: dict[int, float] = {}  # an optimum refined more than once (several barriers): its best refine
+    for _, sol in searched.final:
+        if sol.metrics.tracks:
+            refined[sol.raw.seed] = min(sol.metrics.design_cost, refined.get(sol.raw.seed, float("inf")))
     table["full_path_cost"] = [min((refined[int(x)] for x in seeds.split() if int(x) in refined), default=float("nan"))
                                for seeds in table["seeds"].astype(str)]
     return table

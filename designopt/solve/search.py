@@ -38,9 +38,11 @@ class Search:
     start per problem from each neighbouring structure's better design (`strategies.neighbours`; problems whose
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
     solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None:
-    the profile's; `SolverProfile.linear_solver`). ``refine_mu_init``: the barrier parameter the refine's warm
-    solves start from (IPOPT's ``mu_init``; None: the warm start's own, 1e-4, `designopt.solve.backends.ipopt`): a
-    smaller one keeps a refine in the basin its screened start is in.
+    the profile's; `SolverProfile.linear_solver`). ``refine_mu_init``: the barrier parameters the refine's warm
+    solves start from (IPOPT's ``mu_init``; None: the warm start's own, 1e-4, `designopt.solve.backends.ipopt`),
+    each candidate refined once per value (stages ``refine``, ``refine2``, ...; the answer is the best of all): from
+    a small one a refine stays in the basin its screened start is in, from the warm start's it sometimes walks
+    into a better one and more often into a worse one.
     """
 
     strategy: str = "coarse_to_fine"
@@ -61,7 +63,7 @@ class Search:
     structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
     explore_linear_solver: str | None = None
-    refine_mu_init: float | None = None
+    refine_mu_init: tuple[float | None, ...] = (None,)
 
     @property
     def rebranch_starts(self) -> int:
@@ -87,7 +89,8 @@ class Search:
                  f"branch" if self.rebranch else "")
         kkt = self.explore_linear_solver or self.profile.linear_solver
         kkt = f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
-        barrier = f", barrier from {self.refine_mu_init:g}" if self.refine_mu_init is not None else ""
+        barriers = [f"{mu:g}" if mu is not None else "the warm start's" for mu in self.refine_mu_init]
+        barrier = f", each from barrier {' and '.join(barriers)}" if self.refine_mu_init != (None,) else ""
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){held}{solver}")
@@ -120,7 +123,7 @@ PRESETS: dict[str, Search] = {
     # the circle 3 -> 3, at 1.45-1.6x the wall. The best 24 distinct coarse optima screened instead of 12: on 20
     # other evaluation seeds (1241-1260) seeds better / worse 2 / 1 (main job), 7 / 1 (physical stiffness), 5 / 0
     # (the circle), at 1.08x the wall (docs/benchmarks.md, "Search"; docs/decisions.md, 2026-11-26)
-    "default": Search(starts=160, screen=24, explore_linear_solver="ldl"),
+    "default": Search(starts=160, screen=24, explore_linear_solver="ldl", refine_mu_init=(None, 1e-6)),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,

@@ -14,7 +14,8 @@ design optimal for the full path. Stages, each across every problem:
    optima lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter`` and ranked again there:
    the coarse ranking alone often puts a design that lifts badly ahead of one that lifts well.
 3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
-   trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given.
+   trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
+   once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
 """
 
 from __future__ import annotations
@@ -52,6 +53,11 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     return tasks
 
 
+def refine_stage(i: int) -> str:
+    """The stage name of the refines from a search's ``i``-th barrier (`Search.refine_mu_init`): refine, refine2, ..."""
+    return "refine" if i == 0 else f"refine{i + 1}"
+
+
 def rebranched_tasks(found, search) -> list[Task]:
     """For every job's exploration (its (task, solution) pairs), its ``search.rebranch`` best distinct coarse optima
     each started ``search.rebranch_starts`` (``starts // rebranch``) times on a new joint branch, as the task that
@@ -86,6 +92,7 @@ def plan(jobs, search):
                              search, search.screen_max_iter)
         found = dict(zip(screened, by_job(sub, (yield tasks)), strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
-    final = by_job(jobs, (yield lifted_tasks(jobs, candidates, search.refine, "refine", None, search,
-                                             mu_init=search.refine_mu_init)))
+    refines = [task for i, mu in enumerate(search.refine_mu_init)
+               for task in lifted_tasks(jobs, candidates, search.refine, refine_stage(i), None, search, mu_init=mu)]
+    final = by_job(jobs, (yield refines))
     return [Searched(job, e, f) for job, e, f in zip(jobs, explored, final, strict=True)]
