@@ -8,11 +8,17 @@ from __future__ import annotations
 import numpy as np
 
 
-def design_distance(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> float:
-    """Largest difference between two designs: metres for lengths, radians (wrapped to [-pi, pi]) for angles."""
+def design_distances(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Largest difference between design ``a`` and each design in the last axis of ``b`` (one design, or one per
+    row): metres for lengths, radians (wrapped to [-pi, pi]) for angles; 0 without design joints."""
     d = np.asarray(a, float) - np.asarray(b, float)
     d = np.where(angle, np.arctan2(np.sin(d), np.cos(d)), d)
-    return float(np.max(np.abs(d))) if d.size else 0.0
+    return np.max(np.abs(d), axis=-1, initial=0.0)
+
+
+def design_distance(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> float:
+    """Largest difference between two designs (`design_distances`)."""
+    return float(design_distances(a, b, angle))
 
 
 def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, tol: float = 0.02) -> np.ndarray:
@@ -25,9 +31,7 @@ def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, t
     labels, leaders, n = np.empty(len(costs), dtype=int), np.empty_like(designs), 0
     for i in order:
         if n:
-            d = designs[i] - leaders[:n]
-            d = np.where(angle, np.arctan2(np.sin(d), np.cos(d)), d)
-            near = np.flatnonzero(np.max(np.abs(d), axis=1, initial=0.0) <= tol)
+            near = np.flatnonzero(design_distances(designs[i], leaders[:n], angle) <= tol)
             if near.size:
                 labels[i] = near[0]
                 continue
