@@ -74,16 +74,22 @@ def load(path: Path):
     return load_config(path)
 
 
-def solutions_table(solutions, title: str) -> Table:
+def solutions_table(solutions, title: str, stages: list[str] | None = None) -> Table:
+    """One row per solve, best first; a stage column when the solves come from more than one stage (a seed refined
+    from two barriers is then two rows: refine and refine2)."""
+    staged = stages is not None and len(set(stages)) > 1
+    stage_of = {id(s): st for s, st in zip(solutions, stages, strict=True)} if staged else {}
     table = Table(title=title)
-    for col in ("seed", "status", "iter", "time [s]", "design cost", "pos err [m]", "axis err", "max step",
-                "tracks"):
-        table.add_column(col, justify="right")
+    columns = ("seed", "stage", "status", "iter", "time [s]", "design cost", "pos err [m]", "axis err", "max step",
+               "tracks")
+    for col in columns if staged else tuple(c for c in columns if c != "stage"):
+        table.add_column(col, justify="left" if col == "stage" else "right")
     for s in sorted(solutions, key=lambda s: (not s.metrics.tracks, s.metrics.design_cost)):
         m, r = s.metrics, s.raw
-        table.add_row(str(r.seed), r.status, str(r.iterations), f"{r.solve_time_s:.2f}", f"{m.design_cost:.6g}",
-                      f"{m.max_position_error:.3e}", f"{m.max_axis_error:.3e}", f"{m.max_joint_step:.4f}",
-                      "yes" if m.tracks else "no")
+        stage = (stage_of[id(s)],) if staged else ()
+        table.add_row(str(r.seed), *stage, r.status, str(r.iterations), f"{r.solve_time_s:.2f}",
+                      f"{m.design_cost:.6g}", f"{m.max_position_error:.3e}", f"{m.max_axis_error:.3e}",
+                      f"{m.max_joint_step:.4f}", "yes" if m.tracks else "no")
     return table
 
 
@@ -122,7 +128,7 @@ def run(
                      f" -- nothing tracked in the {stages[-1][0]} stage, so nothing was refined: try more starts "
                      "(search.starts), another start placement or search.preset paper (starts on the full path)"))
     show(solutions_table(result.solutions, f"{cfg.name}: {problem.chain.structure}, "
-                                           f"stiffness {problem.stiffness.describe()}"))
+                                           f"stiffness {problem.stiffness.describe()}", result.stages))
     if len(result.solution_set):
         show(_frame_table(result.solution_set.head(8), f"distinct optima reached ({len(result.solution_set)} among "
                                                        f"{len(result.explored or result.solutions)} solves; "

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import pandas as pd
@@ -54,10 +55,13 @@ def test_run_writes_the_run_directory(finished_run):
 
 def test_progress_is_plain_lines_when_not_on_a_terminal(tmp_path, monkeypatch):
     """In a log file or CI (the test runner's output is not a terminal) rich draws no bar: a line now and then
-    says how far the work is (here after every solve)."""
+    says how far the work is (here after every solve). With each candidate refined from two barriers, the table
+    of refined solves says which refine each row is."""
     import cli.main
+    from designopt.solve.search import PRESETS
 
     monkeypatch.setattr(cli.main, "PLAIN_PROGRESS_EVERY_S", 0.0)
+    monkeypatch.setitem(PRESETS, "quick", replace(PRESETS["quick"], refine_mu_init=(None, 1e-6)))
     config = tmp_path / "gantry.yaml"
     config.write_text(yaml.safe_dump(gantry_config(design=["a", "x", "z"], search={"preset": "quick", "starts": 3})))
     result = runner.invoke(app, ["run", str(config), "--out", str(tmp_path / "r"), "--jobs", "1", "--no-figures"])
@@ -65,6 +69,11 @@ def test_progress_is_plain_lines_when_not_on_a_terminal(tmp_path, monkeypatch):
     lines = re.findall(r": (\d+) of (\d+) solves planned so far, (\d+) not tracking", result.output)
     assert len(lines) >= 4 and [int(done) for done, _, _ in lines] == list(range(1, len(lines) + 1))
     assert all(int(done) <= int(total) for done, total, _ in lines)
+    header = next(line for line in result.output.splitlines() if "design cost" in line)
+    assert re.search(r"seed\s*┃\s*stage\s*┃\s*status", header), header
+    table = result.output.split(header, 1)[1].split("└", 1)[0]  # the refined solves' rows
+    staged = re.findall(r"^│\s*\d+\s*│\s*(\S+)\s*│", table, flags=re.M)
+    assert sorted(set(staged)) == ["refine", "refine2"] and staged.count("refine") == staged.count("refine2")
 
 
 def test_view_command_writes_one_offline_file(finished_run, tmp_path):

@@ -41,6 +41,7 @@ class RunResult:
     directory: RunDirectory
     problem: DesignProblem
     solutions: list[Solution]  # the solves on the full path (for coarse_to_fine: the refined optima)
+    stages: list[str]  # the search stage of each of ``solutions`` (refine, refine2, neighbour, ...; final: multistart)
     explored: list[Solution]  # the exploration's solves on the coarse path (none for multistart)
     best: Solution | None
     summary: pd.DataFrame
@@ -79,5 +80,5 @@ def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, pro
                          for name in SOLUTION_FIGURES]
             drawings.append(Drawing("designopt.view", "write_view", (best, run.path / "view.html")))
         draw(drawings, jobs)
-    return RunResult(run, problem, [sol for _, sol in searched.final], [sol for _, sol in searched.explore], best,
-                     summary, optima)
+    return RunResult(run, problem, [sol for _, sol in searched.final], [task.stage for task, _ in searched.final],
+                     [sol for _, sol in searched.explore], best, summary, optima)
