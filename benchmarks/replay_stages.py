@@ -1,0 +1,93 @@
+"""Replay finished runs from one stage on with this checkout's search: what would another screen or refine answer?
+
+A run's exploration is most of its cost, and a change to a later stage (the screen, the refine) leaves it as it
+is. For each RUN (a directory `search_seeds.py --out DIR` keeps, DIR/<name>/s<seed>), this copies it to
+``--out``, drops the rows and solution files of ``--from`` and every stage after it (summary.csv, solutions/), and
+finishes the copy with `designopt run CONFIG --resume` in this checkout (its config.yaml; a subprocess, so the
+checkout's own `designopt` is the one imported): the kept stages are read back, the dropped ones solved again.
+Prints each run's answer before and after against the best design known, and both distributions.
+
+    .venv/bin/python benchmarks/replay_stages.py DIR/milling/s* --from screen --out REPLAY \
+        --reference benchmarks/reference/milling_best_known.json
+
+Run it from a `git worktree` that holds the variant (e.g. another screen barrier in `PRESETS["default"]`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parent.parent
+ORDER = ("explore", "screen", "refine")  # a stage's rows are dropped with every later one (refine2, ... follow)
+
+
+def later(stage: str, start: str) -> bool:
+    """Whether ``stage`` is ``start`` or comes after it (refine2, refine3 after refine)."""
+    base = stage.rstrip("0123456789")
+    return base in ORDER and ORDER.index(base) >= ORDER.index(start)
+
+
+def strip(run: Path, start: str) -> int:
+    """Drop the rows and solution files of ``start`` and later stages; the number of rows dropped."""
+    summary = pd.read_csv(run / "summary.csv")
+    drop = summary["stage"].astype(str).map(lambda s: later(s, start))
+    for name in summary.loc[drop, "solution_file"].dropna():
+        (run / str(name)).unlink(missing_ok=True)
+    summary.loc[~drop].to_csv(run / "summary.csv", index=False)
+    for name in ("best.json", "solution_set.csv"):
+        (run / name).unlink(missing_ok=True)
+    return int(drop.sum())
+
+
+def quartiles(a: np.ndarray) -> str:
+    return (f"{a.min():.3f} / {np.median(a):.3f} / {np.percentile(a, 90):.3f} / {a.max():.3f}, "
+            f"{int((a <= 1.10).sum())} of {len(a)} within 1.10x")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("runs", nargs="+", type=Path)
+    parser.add_argument("--from", dest="start", choices=ORDER[1:], default="screen")
+    parser.add_argument("--out", type=Path, required=True, help="where the copies go (one per run)")
+    parser.add_argument("--reference", required=True, help="the best design known (a solution file)")
+    args = parser.parse_args()
+    known = json.loads((ROOT / args.reference).read_text())["metrics"]["design_cost"]
+    before, after = [], []
+    for run in args.runs:
+        experiment = run.parent.name
+        copy = args.out / experiment / run.name
+        if copy.exists():
+            sys.exit(f"{copy}: exists already (say another --out)")
+        shutil.copytree(run, copy)
+        dropped = strip(copy, args.start)
+        t0 = time.perf_counter()
+        done = subprocess.run([sys.executable, "-m", "cli.main", "run", str(copy / "config.yaml"), "--out",
+                               str(args.out), "--name", run.name, "--resume", "--no-figures"], cwd=ROOT,
+                              capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        if done.returncode not in (0, 3):
+            sys.exit(f"{run}: designopt run --resume exited {done.returncode}: {done.stderr.strip()}")
+        was = json.loads((run / "best.json").read_text())["metrics"]["design_cost"] / known
+        best = copy / "best.json"
+        now = json.loads(best.read_text())["metrics"]["design_cost"] / known if best.exists() else np.inf
+        before.append(was)
+        after.append(now)
+        print(f"{run}: {was:.3f} -> {now:.3f}x the best known ({dropped} solves dropped and solved again, "
+              f"{wall:.1f} s wall)", flush=True)
+    b, a = np.array(before), np.array(after)
+    print(f"as run: {quartiles(b)}")
+    print(f"replayed from {args.start}: {quartiles(a)}")
+    print(f"runs better / worse (by more than 0.5 %): {int((a < 0.995 * b).sum())} / {int((a > 1.005 * b).sum())}")
+
+
+if __name__ == "__main__":
+    main()
