@@ -34,7 +34,7 @@ from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solve import Job, SolverProfile, preset, run_search
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
-from designopt.tables import COARSE_STAGES
+from designopt.tables import is_coarse
 from designopt.verify import verify_file
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -50,7 +50,7 @@ def best_per_case(summary: pd.DataFrame, prefix: str, full_path: bool = False) -
     only (not a search's coarse stages)."""
     rows = summary[summary["case"].astype(str).str.startswith(prefix) & (summary["tracks"].astype(str) == "True")]
     if full_path:
-        rows = rows[~rows["stage"].isin(COARSE_STAGES)]
+        rows = rows[~rows["stage"].map(is_coarse)]
     return rows.groupby("case")["design_cost"].min()
 
 
@@ -133,7 +133,7 @@ def main() -> None:
 
     # the best design as a solution file, when it beats the one kept
     row = summary[(summary["case"] == f"f{best['assignment']}") & (summary["tracks"].astype(str) == "True")
-                  & ~summary["stage"].isin(COARSE_STAGES)]
+                  & ~summary["stage"].map(is_coarse)]
     path = run.path / row.sort_values("design_cost").iloc[0]["solution_file"]
     reference = Path(args.reference)
     kept = json.loads(reference.read_text())["metrics"]["design_cost"] if reference.exists() else np.inf

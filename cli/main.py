@@ -109,7 +109,7 @@ def run(
 
     Exit code 0 when a design tracks the path, 3 when none does, 2 for bad input."""
     from designopt.experiments.run import run_experiment
-    from designopt.tables import COARSE_STAGES
+    from designopt.tables import is_coarse
 
     cfg = load(config)
     with Bar(f"{cfg.name}: solving") as bar:
@@ -117,7 +117,7 @@ def run(
     problem = result.problem
     if result.explored:
         # every coarse stage (explore on the coarsest path, screen on a finer one) with how many of its solves track
-        coarse = result.summary[result.summary["stage"].isin(COARSE_STAGES)]
+        coarse = result.summary[result.summary["stage"].map(is_coarse)]
         stages = [(stage, len(rows), int(rows["tracks"].astype(str).str.lower().eq("true").sum()))
                   for stage, rows in coarse.groupby("stage", sort=False)]
         parts = [f"{stage} {solves} solves ({tracking} track)" for stage, solves, tracking in stages]

@@ -17,10 +17,10 @@ OPTIMA_SHOWN = 15  # distinct optima drawn in the search-progress figure, best f
 
 
 def full_path(summary: pd.DataFrame) -> pd.DataFrame:
-    """The rows of full-path solves (not the coarse stages of a search: `designopt.tables.COARSE_STAGES`)."""
-    from designopt.tables import COARSE_STAGES
+    """The rows of full-path solves (not the coarse stages of a search: `designopt.tables.is_coarse`)."""
+    from designopt.tables import is_coarse
 
-    return summary[~summary["stage"].isin(COARSE_STAGES)] if "stage" in summary else summary
+    return summary[~summary["stage"].map(is_coarse)] if "stage" in summary else summary
 
 
 def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Path) -> list[Path]:

@@ -42,9 +42,20 @@ def best_per_dof(table: pd.DataFrame) -> pd.DataFrame:
 COARSE_STAGES = ("explore", "screen")  # solves on a coarser sampling of the path; every other stage is full-path
 
 
+def stage_kind(stage) -> str:
+    """A stage's name without its number: a search that screens or refines from several barriers names the second
+    pass ``screen2``, ``refine2`` (`designopt.solve.strategies.coarse_to_fine.numbered_stage`)."""
+    return str(stage).rstrip("0123456789")
+
+
+def is_coarse(stage) -> bool:
+    """Whether a stage solves on a coarser sampling of the path (`COARSE_STAGES`, numbered or not)."""
+    return stage_kind(stage) in COARSE_STAGES
+
+
 def _stage_of(stage) -> str:
     """explore, screen, or final (any full-path stage: refine, a multistart start, a neighbour start)."""
-    return stage if stage in COARSE_STAGES else "final"
+    return stage_kind(stage) if is_coarse(stage) else "final"
 
 
 def structure_table(summary: pd.DataFrame) -> pd.DataFrame:

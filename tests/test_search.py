@@ -352,14 +352,15 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
 
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter,
-    refinement within the profile's max_iter (once from each barrier of refine_mu_init): a screening solve only
+    refinement within the profile's max_iter (screen and refine once from each barrier of screen_mu_init and
+    refine_mu_init): a screening solve only
     ranks, so a stalling one must not take the full budget (design only stalls there). The caps are read off the
     tasks each stage was given, so the test does not depend on which solve reaches its cap; the screen's cap is
     loose enough that its optima track and a refine follows."""
     problem = problem_from_config(parse_config(milling_12))
     search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
                     screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),  # rebranch: its own test
-                    explore_linear_solver="ldl", refine_mu_init=(None, 1e-6))
+                    explore_linear_solver="ldl", screen_mu_init=(None, 1e-7), refine_mu_init=(None, 1e-6))
     done = []
 
     def execute(tasks):
@@ -367,21 +368,59 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
         return done[-len(tasks):]
 
     run_search([Job("", problem)], search, execute)
-    caps = {"explore": 100, "screen": 150, "refine": 300, "refine2": 300}
+    caps = {"explore": 100, "screen": 150, "screen2": 150, "refine": 300, "refine2": 300}
     assert {t.stage for t, _ in done} == set(caps)
     for stage, cap in caps.items():
         assert all(t.profile.max_iter == cap for t, _ in done if t.stage == stage)
         assert max(s.raw.iterations for t, s in done if t.stage == stage) <= cap
     waypoints = {t.stage: t.problem.toolpath.n for t, _ in done}
-    assert waypoints == {"explore": 6, "screen": 9, "refine": 12, "refine2": 12}
+    assert waypoints == {"explore": 6, "screen": 9, "screen2": 9, "refine": 12, "refine2": 12}
     solvers = {t.stage: t.profile.linear_solver for t, _ in done}  # and the exploration its own linear solver
-    assert solvers == {"explore": "ldl", "screen": "mumps", "refine": "mumps", "refine2": "mumps"}
-    # each candidate refined once per barrier: the warm start's own, then 1e-6
+    assert set(solvers.values()) == {"mumps"} | {"ldl"} and solvers["explore"] == "ldl"
+    # each candidate screened once per screen barrier (the warm start's own, then 1e-7) and refined once per refine
+    # barrier (the warm start's own, then 1e-6)
     barriers = {t.stage: dict(t.profile.options).get("ipopt.mu_init") for t, _ in done}
-    assert barriers == {"explore": None, "screen": None, "refine": None, "refine2": 1e-6}
-    starts = {stage: sorted(t.seed for t, _ in done if t.stage == stage) for stage in ("refine", "refine2")}
+    assert barriers == {"explore": None, "screen": None, "screen2": 1e-7, "refine": None, "refine2": 1e-6}
+    starts = {stage: sorted(t.seed for t, _ in done if t.stage == stage)
+              for stage in ("screen", "screen2", "refine", "refine2")}
+    assert starts["screen"] == starts["screen2"] and len(starts["screen"]) == 3
     assert starts["refine"] == starts["refine2"] and len(starts["refine"]) == 1
+    # the refines start from the cheapest of every screened solve, from either barrier
+    screened = [s for t, s in done if t.stage in ("screen", "screen2") and s.metrics.tracks]
+    cheapest = min(screened, key=lambda s: s.metrics.design_cost)
+    assert all(t.start.solution is cheapest for t, _ in done if t.stage in ("refine", "refine2"))
     assert all(t.profile.warm for t, _ in done if t.stage != "explore")
+
+
+def test_the_refine_ranks_every_screen_pass_together(milling_12):
+    """With two screen barriers, the refine's candidates are the cheapest distinct of both passes' screened
+    solves: here the second pass's solves are made to look cheaper (their design cost halved), so the one refine
+    must start from the cheapest of them; from the first pass's if the second is made dearer."""
+    problem = problem_from_config(parse_config(milling_12))
+    search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=2,
+                    screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),
+                    screen_mu_init=(None, 1e-6))
+    for factor, favoured in ((0.5, "screen2"), (2.0, "screen")):
+        done = []
+
+        def execute(tasks, factor=factor):
+            out = []
+            for t in tasks:
+                sol = run_task(t)
+                if t.stage == "screen2":
+                    sol = replace(sol, metrics=replace(sol.metrics, design_cost=factor * sol.metrics.design_cost))
+                out.append((t, sol))
+            done.extend(out)
+            return out
+
+        run_search([Job("", problem)], search, execute)
+        by_stage = {}
+        for t, sol in done:
+            by_stage.setdefault(t.stage, []).append(sol)
+        assert len(by_stage["screen"]) == len(by_stage["screen2"]) >= 1
+        (refined,) = [t.start.solution for t, _ in done if t.stage == "refine"]
+        cheapest = min((s for s in by_stage[favoured] if s.metrics.tracks), key=lambda s: s.metrics.design_cost)
+        assert refined is cheapest
 
 
 @settings(max_examples=60, deadline=None)

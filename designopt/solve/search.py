@@ -42,7 +42,8 @@ class Search:
     solves start from (IPOPT's ``mu_init``; None: the warm start's own, 1e-4, `designopt.solve.backends.ipopt`),
     each candidate refined once per value (stages ``refine``, ``refine2``, ...; the answer is the best of all): from
     a small one a refine stays in the basin its screened start is in, from the warm start's it sometimes walks
-    into a better one and more often into a worse one.
+    into a better one and more often into a worse one. ``screen_mu_init``: the same for the screen (stages
+    ``screen``, ``screen2``, ...), every screened solve of all of them ranked together for the refine.
     """
 
     strategy: str = "coarse_to_fine"
@@ -63,6 +64,7 @@ class Search:
     structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
     explore_linear_solver: str | None = None
+    screen_mu_init: tuple[float | None, ...] = (None,)
     refine_mu_init: tuple[float | None, ...] = (None,)
 
     @property
@@ -84,16 +86,23 @@ class Search:
             stall = f"; a TO start no closer to the path for {StalledViolation.PATIENCE} iterations is stopped"
             return f"multistart: {self.starts} seeded starts{drawn} on the full path ({cap}){stall}{held}{solver}"
         screen = (f", the best {self.screen} distinct re-ranked on {self.screen_waypoints} waypoints "
-                  f"(<= {self.screen_max_iter} iterations, if the path has more)" if self.screen_waypoints else "")
+                  f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}, if the path has more)"
+                  if self.screen_waypoints else "")
         again = (f", the best {self.rebranch} distinct restarted {self.rebranch_starts} times each on a new joint "
                  f"branch" if self.rebranch else "")
         kkt = self.explore_linear_solver or self.profile.linear_solver
         kkt = f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
-        barriers = [f"{mu:g}" if mu is not None else "the warm start's" for mu in self.refine_mu_init]
-        barrier = f", each from barrier {' and '.join(barriers)}" if self.refine_mu_init != (None,) else ""
+        barrier = _barriers(self.refine_mu_init)
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){held}{solver}")
+
+
+def _barriers(mu_init: tuple[float | None, ...]) -> str:
+    """A stage's barriers in words (`Search.screen_mu_init`, `Search.refine_mu_init`); nothing for the warm start's."""
+    if mu_init == (None,):
+        return ""
+    return ", each from barrier " + " and ".join(f"{mu:g}" if mu is not None else "the warm start's" for mu in mu_init)
 
 
 # IPOPT options for design spaces whose tracking Jacobian goes rank-deficient on the way: a structure with fewer

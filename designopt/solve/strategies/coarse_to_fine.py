@@ -12,7 +12,8 @@ design optimal for the full path. Stages, each across every problem:
    the best basin only when its design and its branch both fit, and good designs are where to look for branches.
 2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    optima lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter`` and ranked again there:
-   the coarse ranking alone often puts a design that lifts badly ahead of one that lifts well.
+   the coarse ranking alone often puts a design that lifts badly ahead of one that lifts well. Once per barrier of
+   ``screen_mu_init`` (stages ``screen``, ``screen2``, ...), all of them ranked together.
 3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
    once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
@@ -53,9 +54,10 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     return tasks
 
 
-def refine_stage(i: int) -> str:
-    """The stage name of the refines from a search's ``i``-th barrier (`Search.refine_mu_init`): refine, refine2, ..."""
-    return "refine" if i == 0 else f"refine{i + 1}"
+def numbered_stage(stage: str, i: int) -> str:
+    """The name of a stage's pass from a search's ``i``-th barrier (`Search.screen_mu_init`,
+    `Search.refine_mu_init`): screen, screen2, ...; refine, refine2, ..."""
+    return stage if i == 0 else f"{stage}{i + 1}"
 
 
 def rebranched_tasks(found, search) -> list[Task]:
@@ -88,11 +90,14 @@ def plan(jobs, search):
     screened = [k for k, job in enumerate(jobs) if 0 < search.screen_waypoints < job.problem.toolpath.n]
     if screened:
         sub = [jobs[k] for k in screened]
-        tasks = lifted_tasks(sub, [explored[k] for k in screened], search.screen, "screen", search.screen_waypoints,
-                             search, search.screen_max_iter)
+        tasks = [task for i, screen_mu in enumerate(search.screen_mu_init)
+                 for task in lifted_tasks(sub, [explored[k] for k in screened], search.screen,
+                                          numbered_stage("screen", i), search.screen_waypoints, search,
+                                          search.screen_max_iter, mu_init=screen_mu)]
         found = dict(zip(screened, by_job(sub, (yield tasks)), strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
-    refines = [task for i, mu in enumerate(search.refine_mu_init)
-               for task in lifted_tasks(jobs, candidates, search.refine, refine_stage(i), None, search, mu_init=mu)]
+    refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
+               for task in lifted_tasks(jobs, candidates, search.refine, numbered_stage("refine", i), None, search,
+                                        mu_init=refine_mu)]
     final = by_job(jobs, (yield refines))
     return [Searched(job, e, f) for job, e, f in zip(jobs, explored, final, strict=True)]
