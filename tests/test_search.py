@@ -403,7 +403,7 @@ def test_the_refine_ranks_every_screen_pass_together(milling_12):
     for factor, favoured in ((0.5, "screen2"), (2.0, "screen")):
         done = []
 
-        def execute(tasks, factor=factor):
+        def execute(tasks, factor=factor, done=done):
             out = []
             for t in tasks:
                 sol = run_task(t)

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designopt.solve import cluster_designs, design_distance
-from designopt.tables import best_so_far
+from designopt.tables import best_so_far, is_coarse, structure_table
 
 
 def test_design_distance_wraps_angles():
@@ -52,6 +52,19 @@ def test_best_so_far_ignores_solves_that_do_not_track():
     table = best_so_far(summary)
     assert list(table["best_cost"]) == [3.0, 3.0, 2.0, 0.5]
     assert list(table["solver_seconds"]) == [1.0, 3.0, 3.5, 5.0]
+
+
+def test_numbered_coarse_stages_are_coarse_and_never_a_structures_answer():
+    """A second screen pass (screen2) is a coarse stage like the first; a second refine (refine2) is full-path: a
+    structure's best is read from full-path rows only, however cheap a coarse one looks."""
+    assert [is_coarse(s) for s in ("explore", "screen", "screen2", "refine", "refine2", "neighbour", "final")] == \
+        [True, True, True, False, False, False, False]
+    summary = pd.DataFrame({"structure": ["RR"] * 4, "stage": ["explore", "screen2", "refine", "refine2"],
+                            "design_cost": [0.1, 0.2, 3.0, 2.0], "tracks": [True, True, True, True],
+                            "status": ["Solve_Succeeded"] * 4, "solution_file": ["e", "s", "r", "r2"],
+                            "solve_time_s": [1.0] * 4})
+    row = structure_table(summary).iloc[0]
+    assert row["design_cost"] == 2.0 and row["best_solution"] == "r2" and row["starts"] == 2
 
 
 def test_search_progress_figure_draws_the_best_optima_relative_to_the_best(tmp_path, monkeypatch):
