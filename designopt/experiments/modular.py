@@ -229,14 +229,14 @@ def module_screen(search: Search) -> Search:
 def module_refine(search: Search) -> Search:
     """How the neighbourhood search solves its best screened assignments on the full path: the default search
     (coarse to fine; the search's seed) with `REFINE_STARTS` coarse starts, moved until they reach the path (no
-    second round on new joint branches, MUMPS in the exploration too, 12 screened and one refine per candidate: none
-    of these measured on modular robots), as the enumeration that found the best modular robot known solved its
+    second round on new joint branches, MUMPS in the exploration too, 12 screened once and one refine per candidate:
+    none of these measured on modular robots), as the enumeration that found the best modular robot known solved its
     candidates (`benchmarks/modular_enumeration.py`).
     The config's own search (the ``paper`` preset's 4 cold starts in the shipped config) lost 1.3-1.5x on
     assignments it shares with the enumeration; 80 coarse starts missed an assignment's own best on 3 of
     7 evaluation seeds (1.24-1.41x where 160 starts reach 1.05x: docs/decisions.md)."""
     return preset("default", seed=search.seed, init="reach", starts=REFINE_STARTS, rebranch=0, screen=12,
-                  explore_linear_solver=None, refine_mu_init=(None,))
+                  explore_linear_solver=None, screen_mu_init=(None,), refine_mu_init=(None,))
 
 
 def _module_search(setup, base, catalogue, placement, rounded, modular, budget, refine=NEIGHBOURHOOD_REFINE):
