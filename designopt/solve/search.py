@@ -43,7 +43,7 @@ class Search:
     each candidate refined once per value (stages ``refine``, ``refine2``, ...; the answer is the best of all): from
     a small one a refine stays in the basin its screened start is in, from the warm start's it sometimes walks
     into a better one and more often into a worse one. ``screen_mu_init``: the same for the screen (stages
-    ``screen``, ``screen2``, ...), every screened solve of all of them ranked together for the refine.
+    ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass.
     """
 
     strategy: str = "coarse_to_fine"

@@ -13,7 +13,7 @@ design optimal for the full path. Stages, each across every problem:
 2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    optima lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter`` and ranked again there:
    the coarse ranking alone often puts a design that lifts badly ahead of one that lifts well. Once per barrier of
-   ``screen_mu_init`` (stages ``screen``, ``screen2``, ...), all of them ranked together.
+   ``screen_mu_init`` (stages ``screen``, ``screen2``, ...), each candidate ranked by its better pass.
 3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
    once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
@@ -60,6 +60,20 @@ def numbered_stage(stage: str, i: int) -> str:
     return stage if i == 0 else f"{stage}{i + 1}"
 
 
+def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:
+    """One (task, solution) per start of a stage solved in several passes (`numbered_stage`; the same starts): the
+    pass whose solution tracks at the lowest design cost (the first pass's when none tracks), in start order. A
+    candidate screened twice is one candidate, with its better screen as its start: the refine gets distinct
+    coarse optima, each refined once per barrier (a solve's files are named by stage and start)."""
+    best: dict[int, tuple[Task, object]] = {}
+    for task, sol in done:
+        kept = best.get(task.seed)
+        if kept is None or (sol.metrics.tracks and (not kept[1].metrics.tracks
+                                                    or sol.metrics.design_cost < kept[1].metrics.design_cost)):
+            best[task.seed] = (task, sol)
+    return sorted(best.values(), key=lambda d: d[0].seed)
+
+
 def rebranched_tasks(found, search) -> list[Task]:
     """For every job's exploration (its (task, solution) pairs), its ``search.rebranch`` best distinct coarse optima
     each started ``search.rebranch_starts`` (``starts // rebranch``) times on a new joint branch, as the task that
@@ -94,7 +108,7 @@ def plan(jobs, search):
                  for task in lifted_tasks(sub, [explored[k] for k in screened], search.screen,
                                           numbered_stage("screen", i), search.screen_waypoints, search,
                                           search.screen_max_iter, mu_init=screen_mu)]
-        found = dict(zip(screened, by_job(sub, (yield tasks)), strict=True))
+        found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
                for task in lifted_tasks(jobs, candidates, search.refine, numbered_stage("refine", i), None, search,
