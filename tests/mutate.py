@@ -133,7 +133,7 @@ MUTATIONS = [
              "return {**opts, **(WARM_OPTIONS if profile.warm else {}), **dict(profile.options)}",
              "return {**opts, **(WARM_OPTIONS if profile.warm else {})}", ("tests/test_search.py",)),
     Mutation("screening ignores its iteration cap", "designopt/solve/strategies/coarse_to_fine.py",
-             "search, search.screen_max_iter)", "search)"),
+             "search.screen_max_iter, mu_init=screen_mu)]", "None, mu_init=screen_mu)]"),
     Mutation("a rebranched start draws its first joints within +-pi/2 (the seeded starts' range)",
              "designopt/solve/starts.py", '"box")', '"perturb")'),
     Mutation("the second round left out of the screen's pool", "designopt/solve/strategies/coarse_to_fine.py",
