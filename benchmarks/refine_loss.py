@@ -42,22 +42,36 @@ from designopt.solve.search import Job  # noqa: E402
 from designopt.solve.starts import lifted_guess  # noqa: E402
 from designopt.solve.strategies.coarse_to_fine import coarse_problem, lifted_tasks  # noqa: E402
 from designopt.solve.tasks import run_task  # noqa: E402
+from designopt.tables import stage_kind  # noqa: E402
 from designopt.transcriptions import Collocation  # noqa: E402
 from designopt.transcriptions.trajectory import trajectory  # noqa: E402
 
 
+def screened_start(run: Path, seed: int) -> tuple[Path, float] | None:
+    """The screened solve a refine of ``seed`` started from, and its design cost: with several screen passes
+    (screen, screen2, ...) the better one, as the search picks it (`coarse_to_fine.better_pass`); None when the run
+    refined a coarse optimum (its path had no more waypoints than the screen's)."""
+    d = pd.read_csv(run / "summary.csv")
+    rows = d[(d.seed == seed) & d.stage.map(lambda s: stage_kind(s) == "screen")]
+    if rows.empty:
+        return None
+    tracking = rows[rows.tracks.astype(str) == "True"]
+    best = tracking.loc[tracking.design_cost.idxmin()] if len(tracking) else rows.iloc[0]
+    return run / str(best.solution_file), float(best.design_cost)
+
+
 def refines(run: Path, full, screen_waypoints: int, ref: float) -> list[dict]:
     d = pd.read_csv(run / "summary.csv")
-    screened = d[d.stage == "screen"].set_index("seed")
     rows = []
     for _, r in d[d.stage == "refine"].iterrows():
-        path = next(run.glob(f"solutions/screen-*-s{r.seed}.json"), None)
-        if path is None:  # a refine from a coarse optimum (the path had no more waypoints than the screen's)
+        found = screened_start(run, int(r.seed))
+        if found is None:
             continue
+        path, screened_cost = found
         sol = read_solution_for(coarse_problem(full, screen_waypoints), Collocation(), path)
         guess = lifted_guess(full, sol)
         start = evaluate(full, guess.q_d, trajectory(full.toolpath.t, guess.Q, guess.V))
-        rows.append({"run": run.name, "seed": int(r.seed), "screen": screened.loc[r.seed, "design_cost"] / ref,
+        rows.append({"run": run.name, "seed": int(r.seed), "screen": screened_cost / ref,
                      "lifted_start": start.design_cost / ref, "start_tracks": start.tracks,
                      "step_over_limit": float((np.abs(np.diff(guess.Q, axis=0)) / full.max_steps).max()),
                      "refine": r.design_cost / ref, "refine_tracks": bool(r.tracks)})
@@ -68,7 +82,7 @@ def replayed(config: str, run: str, seed: int, screen_waypoints: int, mu_init: f
     """One refine solved again from its screened start with the refine's barrier from ``mu_init``: (cost, tracks)."""
     cfg = load_config(config)
     search, full = search_from_config(cfg), problem_from_config(cfg)
-    path = next(Path(run).glob(f"solutions/screen-*-s{seed}.json"))
+    path, _ = screened_start(Path(run), seed)
     sol = read_solution_for(coarse_problem(full, screen_waypoints), Collocation(), path)
     task = lifted_tasks([Job("", full)], [[(None, sol)]], 1, "refine", None, search, mu_init=mu_init)[0]
     done = run_task(task)
