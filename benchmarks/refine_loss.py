@@ -47,11 +47,12 @@ from designopt.transcriptions import Collocation  # noqa: E402
 from designopt.transcriptions.trajectory import trajectory  # noqa: E402
 
 
-def screened_start(run: Path, seed: int) -> tuple[Path, float] | None:
-    """The screened solve a refine of ``seed`` started from, and its design cost: with several screen passes
-    (screen, screen2, ...) the better one, as the search picks it (`coarse_to_fine.better_pass`); None when the run
-    refined a coarse optimum (its path had no more waypoints than the screen's)."""
-    d = pd.read_csv(run / "summary.csv")
+def screened_start(run: Path, summary: pd.DataFrame, seed: int) -> tuple[Path, float] | None:
+    """The screened solve a refine of ``seed`` started from (``summary``: the run's summary.csv), and its design
+    cost: with several screen passes (screen, screen2, ...) the better one, as the search picks it
+    (`coarse_to_fine.better_pass`); None when the run refined a coarse optimum (its path had no more waypoints than
+    the screen's)."""
+    d = summary
     rows = d[(d.seed == seed) & d.stage.map(lambda s: stage_kind(s) == "screen")]
     if rows.empty:
         return None
@@ -64,7 +65,7 @@ def refines(run: Path, full, screen_waypoints: int, ref: float) -> list[dict]:
     d = pd.read_csv(run / "summary.csv")
     rows = []
     for _, r in d[d.stage == "refine"].iterrows():
-        found = screened_start(run, int(r.seed))
+        found = screened_start(run, d, int(r.seed))
         if found is None:
             continue
         path, screened_cost = found
@@ -82,7 +83,7 @@ def replayed(config: str, run: str, seed: int, screen_waypoints: int, mu_init: f
     """One refine solved again from its screened start with the refine's barrier from ``mu_init``: (cost, tracks)."""
     cfg = load_config(config)
     search, full = search_from_config(cfg), problem_from_config(cfg)
-    path, _ = screened_start(Path(run), seed)
+    path, _ = screened_start(Path(run), pd.read_csv(Path(run) / "summary.csv"), seed)
     sol = read_solution_for(coarse_problem(full, screen_waypoints), Collocation(), path)
     task = lifted_tasks([Job("", full)], [[(None, sol)]], 1, "refine", None, search, mu_init=mu_init)[0]
     done = run_task(task)

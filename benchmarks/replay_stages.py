@@ -26,14 +26,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from designopt.tables import stage_kind
+
 ROOT = Path(__file__).resolve().parent.parent
 ORDER = ("explore", "screen", "refine")  # a stage's rows are dropped with every later one (refine2, ... follow)
 
 
 def later(stage: str, start: str) -> bool:
-    """Whether ``stage`` is ``start`` or comes after it (refine2, refine3 after refine)."""
-    base = stage.rstrip("0123456789")
-    return base in ORDER and ORDER.index(base) >= ORDER.index(start)
+    """Whether ``stage`` is ``start`` or comes after it (screen2 after screen, refine2 after refine)."""
+    kind = stage_kind(stage)
+    return kind in ORDER and ORDER.index(kind) >= ORDER.index(start)
 
 
 def strip(run: Path, start: str) -> int:

@@ -115,8 +115,9 @@ MUTATIONS = [
              "[[x for x in d if x[0].stage == 'screen'] for d in by_job(sub, (yield tasks))]",
              ("tests/test_search.py",)),
     Mutation("a candidate screened twice keeps its dearer pass", "designopt/solve/strategies/coarse_to_fine.py",
-             "or sol.metrics.design_cost < kept[1].metrics.design_cost",
-             "or sol.metrics.design_cost > kept[1].metrics.design_cost", ("tests/test_search.py",)),
+             "kept = best_solution([sol for _, sol in passes[seed]])",
+             "kept = max((s for _, s in passes[seed] if s.metrics.tracks), key=lambda s: s.metrics.design_cost, "
+             "default=None)", ("tests/test_search.py",)),
     Mutation("lifted start drops the coarse design", "designopt/solve/starts.py",
              "q_d = np.asarray(solution.raw.q_d, float)", "q_d = problem.chain.design_values"),
     Mutation("a lifted start's waypoints left where the coarse trajectory puts them", "designopt/solve/starts.py",

@@ -24,7 +24,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from designopt.problem import DesignProblem
-from designopt.solve.optima import distinct_best
+from designopt.solve.optima import best_solution, distinct_best
 from designopt.solve.search import Searched, by_job
 from designopt.solve.starts import Lifted, Rebranched
 from designopt.solve.strategies.steps import seeded_tasks, solve_setup
@@ -65,13 +65,14 @@ def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:
     pass whose solution tracks at the lowest design cost (the first pass's when none tracks), in start order. A
     candidate screened twice is one candidate, with its better screen as its start: the refine gets distinct
     coarse optima, each refined once per barrier (a solve's files are named by stage and start)."""
-    best: dict[int, tuple[Task, object]] = {}
+    passes: dict[int, list[tuple[Task, object]]] = {}
     for task, sol in done:
-        kept = best.get(task.seed)
-        if kept is None or (sol.metrics.tracks and (not kept[1].metrics.tracks
-                                                    or sol.metrics.design_cost < kept[1].metrics.design_cost)):
-            best[task.seed] = (task, sol)
-    return sorted(best.values(), key=lambda d: d[0].seed)
+        passes.setdefault(task.seed, []).append((task, sol))
+    out = []
+    for seed in sorted(passes):
+        kept = best_solution([sol for _, sol in passes[seed]])
+        out.append(next((pair for pair in passes[seed] if pair[1] is kept), passes[seed][0]))
+    return out
 
 
 def rebranched_tasks(found, search) -> list[Task]:
