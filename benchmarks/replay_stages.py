@@ -83,7 +83,8 @@ def main() -> None:
         now = json.loads(best.read_text())["metrics"]["design_cost"] / known if best.exists() else np.inf
         before.append(was)
         after.append(now)
-        print(f"{run}: {was:.3f} -> {now:.3f}x the best known ({dropped} solves dropped and solved again, "
+        solved = int(pd.read_csv(copy / "summary.csv")["stage"].astype(str).map(lambda s: later(s, args.start)).sum())
+        print(f"{run}: {was:.3f} -> {now:.3f}x the best known ({dropped} solves dropped, {solved} solved, "
               f"{wall:.1f} s wall)", flush=True)
     b, a = np.array(before), np.array(after)
     print(f"as run: {quartiles(b)}")
