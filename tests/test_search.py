@@ -7,6 +7,7 @@ from __future__ import annotations
 import copy
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -43,8 +44,9 @@ from designopt.solve import (
     solve_guess,
     solve_one,
 )
+from designopt.solve.optima import design_forms, form_joints
 from designopt.solve.starts import Rebranched
-from designopt.solve.strategies.coarse_to_fine import coarse_problem
+from designopt.solve.strategies.coarse_to_fine import coarse_problem, rebranched_tasks
 from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import units
 from designopt.toolpaths import figure_eight, subsample
@@ -267,6 +269,59 @@ def test_distinct_best_takes_one_solution_per_optimum(milling_12):
     assert distinct_best(sols, 10, tol=0.02) == [3, 1, 2]
     assert distinct_best(sols, 2, tol=0.02) == [3, 1]
     assert distinct_best(sols, 10, tol=2.0) == [3]
+
+
+def test_an_arms_form_is_the_pattern_of_its_joint_axes():
+    """`design_forms`: each twist between two joint axes 0 (parallel: a multiple of pi, either sign) or 1
+    (perpendicular: an odd multiple of pi/2), whatever the lengths; `form_joints` marks the twists between the
+    first and the last moving joint -- not the placement's angles, nor the last link's twist (the tool's)."""
+    chain = problem_from_config(parse_config({})).chain
+    form = form_joints(chain)
+    names = [j.name for j in chain.design]
+    assert [n for n, f in zip(names, form, strict=True) if f] == [f"link{i}.alpha" for i in range(1, 6)]
+    q = chain.design_values.copy()
+    q[form] = [0.0, np.pi - 0.01, -np.pi / 2 + 0.2, 3 * np.pi / 2, -np.pi]
+    other = q + np.where(form, 0.0, 0.37)  # lengths, placement and the last twist moved
+    assert design_forms(np.array([q, other]), form) == [(0, 0, 1, 1, 0)] * 2
+    assert not form_joints(problem_from_config(parse_config({"design": ["placement"]})).chain).any()
+
+
+def _optimum(problem, cost: float, pattern: tuple[int, ...], shift: float):
+    """A tracking solution stand-in: the default design with these twists (multiples of pi/2) and link 2's length
+    moved by ``shift``, at design cost ``cost``."""
+    chain = problem.chain
+    q = chain.design_values.copy()
+    q[form_joints(chain)] = np.array(pattern) * np.pi / 2
+    q[[j.name for j in chain.design].index("link2.a")] += shift
+    return SimpleNamespace(problem=problem, metrics=SimpleNamespace(tracks=True, design_cost=cost),
+                           raw=SimpleNamespace(q_d=q))
+
+
+def test_the_second_rounds_leaders_are_capped_per_form():
+    """``per_form``: the distinct optima in order of cost, at most that many of one form before those of other
+    forms, then the rest by cost; None, or a design space without form joints: by cost alone. The second round
+    (`rebranched_tasks`) starts from the leaders so chosen (`Search.rebranch_per_form`)."""
+    problem = problem_from_config(parse_config({}))
+    a, b, c = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0), (1, 0, 1, 0, 1)
+    sols = [_optimum(problem, cost, form, shift) for cost, form, shift in
+            ((1.0, a, 0.0), (2.0, a, 0.1), (3.0, a, 0.2), (4.0, b, 0.0), (5.0, a, 0.3), (6.0, c, 0.0))]
+    assert distinct_best(sols, 4) == [0, 1, 2, 3]
+    assert distinct_best(sols, 4, per_form=2) == [0, 1, 3, 5]
+    assert distinct_best(sols, 4, per_form=1) == [0, 3, 5, 1]
+    assert distinct_best(sols, 10, per_form=1) == [0, 3, 5, 1, 2, 4]
+
+    placed = problem_from_config(parse_config({"design": ["placement"]}))
+    chain = placed.chain
+    assert distinct_best([SimpleNamespace(problem=placed, metrics=s.metrics,
+                                          raw=SimpleNamespace(q_d=chain.design_values + 0.1 * k))
+                          for k, s in enumerate(sols)], 3, per_form=1) == [0, 1, 2]
+
+    task = Task("", "explore", problem, Collocation(), SolverProfile(), Seeded(0, 0))
+    search = Search(starts=6, rebranch=3, rebranch_per_form=1)
+    tasks = rebranched_tasks([[(task, s) for s in sols]], search)
+    assert [t.start.solution for t in tasks[:: search.rebranch_starts]] == [sols[0], sols[3], sols[5]]
+    assert [t.start.number for t in tasks] == list(range(6, 6 + 3 * search.rebranch_starts))
+    assert "at most 1 of one form" in search.describe()
 
 
 def test_the_search_finds_the_optimum_a_single_start_misses(milling_12):

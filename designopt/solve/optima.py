@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from designopt.kinematics.joints import Role
+
 
 def design_distances(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Largest difference between design ``a`` and each design in the last axis of ``b`` (one design, or one per
@@ -40,20 +42,54 @@ def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, t
     return labels
 
 
-def distinct_best(solutions: list, count: int, tol: float = 0.02) -> list[int]:
+def form_joints(chain) -> np.ndarray:
+    """Which design joints make an arm's form (`design_forms`): its design angles between its first and its last
+    moving joint, which turn one joint axis against the next (a DH link's twist, a URDF joint origin's angles);
+    not the placement's, nor those after the last moving joint (the tool's)."""
+    moving = [k for k, et in enumerate(chain.robot) if chain.joints[et.joint].role is Role.MOVING]
+    inner = {et.joint for et in chain.robot[moving[0] + 1:moving[-1]]} if moving else set()
+    design = [i for i, j in enumerate(chain.joints) if j.role is Role.DESIGN]
+    return np.array([chain.joints[i].kind == "angle" and i in inner for i in design], dtype=bool)
+
+
+def design_forms(designs: np.ndarray, form: np.ndarray) -> list[tuple[int, ...]]:
+    """Each design's form: its design angles marked in ``form`` (`form_joints`), each 0 near a multiple of pi
+    (consecutive joint axes parallel, for a twist) or 1 near an odd multiple of pi/2 (perpendicular) -- the
+    pattern of the arm's joint axes, which its lengths do not change. ``designs``: one design per row."""
+    angles = np.asarray(designs, float).reshape(len(designs), -1)[:, np.asarray(form, bool)]
+    return [tuple(int(v) for v in row) for row in np.rint(angles / (np.pi / 2)).astype(int) % 2]
+
+
+def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int | None = None) -> list[int]:
     """Indices into ``solutions`` of the best tracking solution of each of the ``count`` cheapest distinct
-    optima (`cluster_designs`), cheapest first."""
+    optima (`cluster_designs`), cheapest first. ``per_form``: at most this many optima of one form
+    (`design_forms`) before the optima of other forms, cheapest first; then, if fewer than ``count`` are taken,
+    the cheapest of the rest (None: by cost alone; a design space without form joints has one form, and is
+    taken by cost alone too)."""
     tracking = [i for i, s in enumerate(solutions) if s.metrics.tracks]
     if not tracking or count <= 0:
         return []
-    angle = np.array([j.kind == "angle" for j in solutions[tracking[0]].problem.chain.design], dtype=bool)
+    chain = solutions[tracking[0]].problem.chain
+    angle = np.array([j.kind == "angle" for j in chain.design], dtype=bool)
     costs = np.array([solutions[i].metrics.design_cost for i in tracking])
-    labels = cluster_designs(np.array([solutions[i].raw.q_d for i in tracking]).reshape(len(tracking), -1), costs,
-                             angle, tol)
+    designs = np.array([solutions[i].raw.q_d for i in tracking]).reshape(len(tracking), -1)
+    labels = cluster_designs(designs, costs, angle, tol)
     leaders = {}
     for k in np.argsort(costs, kind="stable"):
-        leaders.setdefault(labels[k], tracking[k])
-    return list(leaders.values())[:count]
+        leaders.setdefault(labels[k], k)
+    ranked = list(leaders.values())  # positions in ``tracking``, cheapest optimum first
+    form = form_joints(chain)
+    if per_form is not None and form.any():
+        forms = design_forms(designs[ranked], form)
+        taken: dict[tuple[int, ...], int] = {}
+        first = []
+        for k, f in zip(ranked, forms, strict=True):
+            if taken.get(f, 0) < per_form:
+                taken[f] = taken.get(f, 0) + 1
+                first.append(k)
+        kept = set(first)
+        ranked = first + [k for k in ranked if k not in kept]
+    return [tracking[k] for k in ranked[:count]]
 
 
 def best_solution(solutions):

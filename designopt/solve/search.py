@@ -28,8 +28,10 @@ class Search:
     task's box, or mixed, odd starts from the box, `designopt.initial_guess`; joints by ``init``): cold starts on
     the full path for ``multistart``; for ``coarse_to_fine`` the exploration's starts on ``explore_waypoints`` of
     the path's waypoints (each capped at ``explore_max_iter``), then the ``rebranch`` best distinct of their optima
-    each started again ``starts // rebranch`` times (at least once) on a new joint branch (the optimum's design,
-    first joints drawn over the whole circle: `designopt.solve.starts.Rebranched`; 0: none), explored alike; the
+    (at most ``rebranch_per_form`` of one form, the pattern of the arm's joint axes, before other forms:
+    `optima.distinct_best`; None: by cost alone) each started again ``starts // rebranch`` times (at least once) on
+    a new joint branch (the optimum's design, first joints drawn over the whole circle:
+    `designopt.solve.starts.Rebranched`; 0: none), explored alike; the
     ``screen`` best distinct of both rounds are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``;
     skipped when the path has no more waypoints), and the
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
@@ -55,6 +57,7 @@ class Search:
     explore_waypoints: int = 10
     explore_max_iter: int = 250
     rebranch: int = 8
+    rebranch_per_form: int | None = None
     screen_waypoints: int = 40
     screen: int = 12
     screen_max_iter: int = 300
@@ -88,8 +91,10 @@ class Search:
         screen = (f", the best {self.screen} distinct re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}, if the path has more)"
                   if self.screen_waypoints else "")
-        again = (f", the best {self.rebranch} distinct restarted {self.rebranch_starts} times each on a new joint "
-                 f"branch" if self.rebranch else "")
+        per_form = (f" (at most {self.rebranch_per_form} of one form)" if self.rebranch_per_form is not None
+                    else "")
+        again = (f", the best {self.rebranch} distinct{per_form} restarted {self.rebranch_starts} times each on a "
+                 f"new joint branch" if self.rebranch else "")
         kkt = self.explore_linear_solver or self.profile.linear_solver
         kkt = f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
         barrier = _barriers(self.refine_mu_init)

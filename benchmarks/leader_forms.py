@@ -1,0 +1,82 @@
+"""Which kinematic forms a search's second round starts from, and where the best known design's form ranks.
+
+A DH arm's form here is the pattern of its twists between consecutive joint axes (alpha_1 .. alpha_{n-1}, each
+rounded to a multiple of pi/2: 0 parallel, 1 perpendicular): the best designs known differ from the common coarse
+optima by their form as well as by their lengths. For each RUN (a directory `search_seeds.py --out DIR` keeps,
+DIR/<name>/s<seed>, with a second round on new joint branches) this reads the first round's coarse optima back,
+picks the second round's leaders as the search does (`optima.distinct_best`, the ``rebranch`` best distinct), and
+prints the run's answer against the best design known, the answer's form, the leaders' forms, and the rank of the
+best known design's form among the first round's distinct optima and among its distinct forms (each form ranked by
+its cheapest optimum): where a search that picked its leaders one per form would have started from it.
+
+    .venv/bin/python benchmarks/leader_forms.py DIR/circle_standoff/s* \
+        --reference benchmarks/reference/circle_standoff_best_known.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
+from designopt.problem import problem_from_config
+from designopt.solution import read_solution_for
+from designopt.solve.optima import distinct_best
+from designopt.solve.search import Job
+from designopt.solve.strategies.coarse_to_fine import coarse_problem
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def form(design: dict[str, float], n_joints: int) -> str:
+    """The twists between consecutive joint axes as a string of 0 (a multiple of pi) and 1 (pi/2 off one)."""
+    twists = [design[f"link{i}.alpha"] for i in range(1, n_joints)]
+    return "".join(str(int(round((a % np.pi) / (np.pi / 2))) % 2) for a in twists)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("runs", nargs="+", type=Path)
+    parser.add_argument("--reference", required=True, help="the best design known (a solution file)")
+    args = parser.parse_args()
+    reference = json.loads((ROOT / args.reference).read_text())
+    known = reference["metrics"]["design_cost"]
+    counts = {"optimum": 0, "form": 0}
+    for run in args.runs:
+        cfg = load_config(run / "config.yaml")
+        search = search_from_config(cfg)
+        problem = problem_from_config(cfg)
+        n = problem.chain.n_moving
+        best_form = form(reference["design_joints"], n)
+        summary = pd.read_csv(run / "summary.csv")
+        first = summary[(summary["stage"].astype(str) == "explore") & (summary["seed"] % 1000 < search.starts)]
+        first = first.sort_values("seed", kind="stable")
+        coarse = coarse_problem(problem, search.explore_waypoints)
+        sols = [read_solution_for(coarse, Job("", problem).transcription, run / f) for f in first["solution_file"]]
+        names = [j.name for j in problem.chain.design]
+        forms = [form(dict(zip(names, s.raw.q_d, strict=True)), n) for s in sols]
+        optima = distinct_best(sols, len(sols), search.distinct)
+        ordered = [forms[i] for i in optima]
+        by_form = list(dict.fromkeys(ordered))
+        leaders = ordered[: search.rebranch]
+        final = summary[summary["stage"].astype(str).str.startswith("refine") & summary["tracks"].astype(bool)]
+        answer = final.loc[final["design_cost"].idxmin()]
+        answer_form = form(json.loads((run / answer["solution_file"]).read_text())["design_joints"], n)
+        rank = ordered.index(best_form) if best_form in ordered else None
+        form_rank = by_form.index(best_form) if best_form in by_form else None
+        counts["optimum"] += rank is not None and rank < search.rebranch
+        counts["form"] += form_rank is not None and form_rank < search.rebranch
+        print(f"{run}: {answer['design_cost'] / known:.3f}x, answer's form {answer_form}; leaders "
+              f"{' '.join(leaders)}; best known form {best_form}: optimum rank {rank}, form rank {form_rank} "
+              f"(of {len(by_form)} forms)", flush=True)
+    print(f"best known form among the leaders: {counts['optimum']} of {len(args.runs)} runs; among the "
+          f"{search.rebranch} best forms: {counts['form']}")
+
+
+if __name__ == "__main__":
+    main()
