@@ -1,16 +1,19 @@
 """Replay finished runs from one stage on with this checkout's search: what would another screen or refine answer?
 
 A run's exploration is most of its cost, and a change to a later stage (the screen, the refine) leaves it as it
-is. For each RUN (a directory `search_seeds.py --out DIR` keeps, DIR/<name>/s<seed>), this copies it to
-``--out``, drops the rows and solution files of ``--from`` and every stage after it (summary.csv, solutions/), and
-finishes the copy with `designopt run CONFIG --resume` in this checkout (its config.yaml; a subprocess, so the
-checkout's own `designopt` is the one imported): the kept stages are read back, the dropped ones solved again.
+is; a change to the second round of the exploration (its starts on new joint branches) leaves the first round as
+it is. For each RUN (a directory `search_seeds.py --out DIR` keeps, DIR/<name>/s<seed>), this copies it to
+``--out``, drops the rows and solution files of ``--from`` and every stage after it (summary.csv, solutions/;
+``rebranch``: the exploration's starts from number ``search.starts`` on, the config's search), and finishes the
+copy with `designopt run CONFIG --resume` in this checkout (its config.yaml; a subprocess, so the checkout's own
+`designopt` is the one imported): the kept stages are read back, the dropped ones solved again.
 Prints each run's answer before and after against the best design known, and both distributions.
 
     .venv/bin/python benchmarks/replay_stages.py DIR/milling/s* --from screen --out REPLAY \
         --reference benchmarks/reference/milling_best_known.json
 
-Run it from a `git worktree` that holds the variant (e.g. another screen barrier in `PRESETS["default"]`).
+Run it from a `git worktree` that holds the variant (e.g. another screen barrier in `PRESETS["default"]`). A
+replay from ``rebranch`` is the same as a run only when the variant's first round is the run's (the same starts).
 """
 
 from __future__ import annotations
@@ -26,28 +29,40 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
 from designopt.tables import stage_kind
 
 ROOT = Path(__file__).resolve().parent.parent
-ORDER = ("explore", "screen", "refine")  # a stage's rows are dropped with every later one (refine2, ... follow)
+# a stage's rows are dropped with every later one (refine2, ... follow); "rebranch" is the exploration's second round
+ORDER = ("explore", "rebranch", "screen", "refine")
 
 
-def later(stage: str, start: str) -> bool:
-    """Whether ``stage`` is ``start`` or comes after it (screen2 after screen, refine2 after refine)."""
+def later(stage: str, number: int, start: str, first_round: int) -> bool:
+    """Whether a solve of ``stage`` with start ``number`` is of ``start`` or after it (screen2 after screen, refine2
+    after refine; an exploration start from index ``first_round`` on is the second round's)."""
     kind = stage_kind(stage)
+    if kind == "explore" and number % 1000 >= first_round:
+        kind = "rebranch"
     return kind in ORDER and ORDER.index(kind) >= ORDER.index(start)
 
 
 def strip(run: Path, start: str) -> int:
     """Drop the rows and solution files of ``start`` and later stages; the number of rows dropped."""
     summary = pd.read_csv(run / "summary.csv")
-    drop = summary["stage"].astype(str).map(lambda s: later(s, start))
+    drop = dropped(summary, start, search_from_config(load_config(run / "config.yaml")).starts)
     for name in summary.loc[drop, "solution_file"].dropna():
         (run / str(name)).unlink(missing_ok=True)
     summary.loc[~drop].to_csv(run / "summary.csv", index=False)
     for name in ("best.json", "solution_set.csv"):
         (run / name).unlink(missing_ok=True)
     return int(drop.sum())
+
+
+def dropped(summary: pd.DataFrame, start: str, first_round: int) -> pd.Series:
+    """The rows of ``summary`` of stage ``start`` and later (`later`)."""
+    return pd.Series([later(str(st), int(n), start, first_round) for st, n in
+                      zip(summary["stage"], summary["seed"], strict=True)], index=summary.index, dtype=bool)
 
 
 def quartiles(a: np.ndarray) -> str:
@@ -83,7 +98,8 @@ def main() -> None:
         now = json.loads(best.read_text())["metrics"]["design_cost"] / known if best.exists() else np.inf
         before.append(was)
         after.append(now)
-        solved = int(pd.read_csv(copy / "summary.csv")["stage"].astype(str).map(lambda s: later(s, args.start)).sum())
+        first_round = search_from_config(load_config(copy / "config.yaml")).starts
+        solved = int(dropped(pd.read_csv(copy / "summary.csv"), args.start, first_round).sum())
         print(f"{run}: {was:.3f} -> {now:.3f}x the best known ({dropped} solves dropped, {solved} solved, "
               f"{wall:.1f} s wall)", flush=True)
     b, a = np.array(before), np.array(after)
