@@ -85,7 +85,7 @@ def main() -> None:
         if copy.exists():
             sys.exit(f"{copy}: exists already (say another --out)")
         shutil.copytree(run, copy)
-        dropped = strip(copy, args.start)
+        n_dropped = strip(copy, args.start)
         t0 = time.perf_counter()
         done = subprocess.run([sys.executable, "-m", "cli.main", "run", str(copy / "config.yaml"), "--out",
                                str(args.out), "--name", run.name, "--resume", "--no-figures"], cwd=ROOT,
@@ -100,7 +100,7 @@ def main() -> None:
         after.append(now)
         first_round = search_from_config(load_config(copy / "config.yaml")).starts
         solved = int(dropped(pd.read_csv(copy / "summary.csv"), args.start, first_round).sum())
-        print(f"{run}: {was:.3f} -> {now:.3f}x the best known ({dropped} solves dropped, {solved} solved, "
+        print(f"{run}: {was:.3f} -> {now:.3f}x the best known ({n_dropped} solves dropped, {solved} solved, "
               f"{wall:.1f} s wall)", flush=True)
     b, a = np.array(before), np.array(after)
     print(f"as run: {quartiles(b)}")
