@@ -140,8 +140,8 @@ PRESETS: dict[str, Search] = {
     # refine from 1e-6 stays in its screened start's basin): on seeds 1261-1280 within 1.10x of the best known, main
     # job 14 -> 15, physical stiffness 8 -> 13, circle 6 -> 9, no seed worse. Each candidate screened twice too, from
     # the same two barriers, ranked by the better: on seeds 1281-1300 (replays of the runs from the screen on)
-    # seeds better / worse 3 / 0 (main job), 5 / 0 (physical stiffness), 5 / 0 (circle); on seeds 1301-1320 the main
-    # job 4 / 0; at 1.18-1.33x the wall
+    # seeds better / worse 3 / 0 (main job), 5 / 0 (physical stiffness), 5 / 0 (circle); on seeds 1301-1320, not
+    # chosen on, 4 / 0, 6 / 0 and 5 / 2 (the circle's distribution unchanged); at 1.18-1.33x the wall
     # (docs/benchmarks.md, "Search"; docs/decisions.md, 2026-11-26/27)
     "default": Search(starts=160, screen=24, explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
                       refine_mu_init=(None, 1e-6)),
