@@ -306,14 +306,12 @@ class ToleranceConfig(_Strict):
 
 class SearchConfig(_Strict):
     """How the problem is searched (`designopt.solve.search`): a named preset, its seed, and optionally another
-    number of starts, another spread of their designs (perturb, box, mixed), or at most this many of the second
-    round's leaders of one form (`Search.rebranch_per_form`)."""
+    number of starts or another spread of their designs (perturb, box, mixed)."""
 
     preset: Literal["quick", "default", "thorough", "paper", "production"] = "default"
     seed: Annotated[int, Field(ge=0)] = 0
     starts: Annotated[int, Field(ge=1, le=100_000)] | None = None
     spread: Literal["perturb", "box", "mixed"] | None = None
-    rebranch_per_form: Annotated[int, Field(ge=1, le=1_000)] | None = None
 
 
 class ModuleRow(_Strict):

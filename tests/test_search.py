@@ -72,9 +72,6 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
                               None, None, boxed, 2)
     assert task.start.spread == "box"
     assert "drawn from the task's box" in boxed.describe() and "box" not in PRESETS["default"].describe()
-    capped = search_from_config(parse_config({"search": {"rebranch_per_form": 2}}))
-    assert capped == replace(PRESETS["default"], rebranch_per_form=2)
-    assert "at most 2 of one form" in capped.describe() and "of one form" not in PRESETS["default"].describe()
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, refine=2, seed=2, profile=PRESETS["quick"].profile)
 

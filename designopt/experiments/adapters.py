@@ -18,11 +18,9 @@ CASES = {"placement_only": ["placement"], "design_only": ["d", "a", "alpha"],
 
 
 def search_from_config(cfg: Config) -> Search:
-    """The config's search: its preset with the config's seed (and number of starts, spread and leaders per form,
-    when given)."""
+    """The config's search: its preset with the config's seed (and number of starts and spread, when given)."""
     s = cfg.search
-    given = {k: v for k, v in (("starts", s.starts), ("spread", s.spread),
-                               ("rebranch_per_form", s.rebranch_per_form)) if v is not None}
+    given = {k: v for k, v in (("starts", s.starts), ("spread", s.spread)) if v is not None}
     return preset(s.preset, seed=s.seed, **given)
 
 
