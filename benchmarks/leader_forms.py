@@ -21,22 +21,27 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from stage_solvers import solved
 
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
 from designopt.problem import problem_from_config
-from designopt.solution import read_solution_for
-from designopt.solve.optima import distinct_best
+from designopt.solve.optima import design_forms, distinct_best, form_joints
 from designopt.solve.search import Job
-from designopt.solve.strategies.coarse_to_fine import coarse_problem
+from designopt.tables import stage_kind
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def form(design: dict[str, float], n_joints: int) -> str:
-    """The twists between consecutive joint axes as a string of 0 (a multiple of pi) and 1 (pi/2 off one)."""
-    twists = [design[f"link{i}.alpha"] for i in range(1, n_joints)]
-    return "".join(str(int(round((a % np.pi) / (np.pi / 2))) % 2) for a in twists)
+def forms(designs: np.ndarray, chain) -> list[str]:
+    """Each design's form (`optima.design_forms` of the chain's `optima.form_joints`) as a string of 0 (parallel)
+    and 1 (perpendicular)."""
+    return ["".join(map(str, f)) for f in design_forms(np.atleast_2d(designs), form_joints(chain))]
+
+
+def named(joints: dict[str, float], chain) -> np.ndarray:
+    """A solution file's design joints (by name) as the chain's design vector."""
+    return np.array([joints[j.name] for j in chain.design])
 
 
 def main() -> None:
@@ -51,22 +56,19 @@ def main() -> None:
         cfg = load_config(run / "config.yaml")
         search = search_from_config(cfg)
         problem = problem_from_config(cfg)
-        n = problem.chain.n_moving
-        best_form = form(reference["design_joints"], n)
-        summary = pd.read_csv(run / "summary.csv")
-        first = summary[(summary["stage"].astype(str) == "explore") & (summary["seed"] % 1000 < search.starts)]
-        first = first.sort_values("seed", kind="stable")
-        coarse = coarse_problem(problem, search.explore_waypoints)
-        sols = [read_solution_for(coarse, Job("", problem).transcription, run / f) for f in first["solution_file"]]
-        names = [j.name for j in problem.chain.design]
-        forms = [form(dict(zip(names, s.raw.q_d, strict=True)), n) for s in sols]
+        chain = problem.chain
+        (best_form,) = forms(named(reference["design_joints"], chain), chain)
+        sols = [sol for task, sol in solved(run, Job("", problem), "explore", search.explore_waypoints)
+                if task.seed % 1000 < search.starts]  # the first round's, in start order
         optima = distinct_best(sols, len(sols), search.distinct)
-        ordered = [forms[i] for i in optima]
+        ordered = forms(np.array([sols[i].raw.q_d for i in optima]), chain)
         by_form = list(dict.fromkeys(ordered))
         leaders = ordered[: search.rebranch]
-        final = summary[summary["stage"].astype(str).str.startswith("refine") & summary["tracks"].astype(bool)]
+        summary = pd.read_csv(run / "summary.csv")
+        final = summary[(summary["stage"].astype(str).map(stage_kind) == "refine") & summary["tracks"].astype(bool)]
         answer = final.loc[final["design_cost"].idxmin()]
-        answer_form = form(json.loads((run / answer["solution_file"]).read_text())["design_joints"], n)
+        answer_joints = json.loads((run / answer["solution_file"]).read_text())["design_joints"]
+        (answer_form,) = forms(named(answer_joints, chain), chain)
         rank = ordered.index(best_form) if best_form in ordered else None
         form_rank = by_form.index(best_form) if best_form in by_form else None
         counts["optimum"] += rank is not None and rank < search.rebranch

@@ -113,14 +113,10 @@ def main() -> None:
         line = []
         tops = {}
         for name in args.solver:
-            by_start: dict[int, list] = {}
-            for task, sol, _ in done[name]:
-                by_start.setdefault(task.seed, []).append(sol)
-            better = {seed: best_solution(sols) or sols[0] for seed, sols in by_start.items()}
-            seeds = sorted(better)
-            ranked = distinct_best([better[s] for s in seeds], args.refine, search.distinct)
-            tops[name] = {seeds[i] for i in ranked}
-            best = best_solution(list(better.values()))
+            better = better_pass([(task, sol) for task, sol, _ in done[name]])  # one per start, as the search ranks
+            ranked = distinct_best([sol for _, sol in better], args.refine, search.distinct)
+            tops[name] = {better[i][0].seed for i in ranked}
+            best = best_solution([sol for _, sol in better])
             cost = best.metrics.design_cost if best is not None else float("nan")
             line.append(f"{name} {sum(c for *_, c in done[name]):.1f} s, best {cost:.6g}")
         shared = f"; top {args.refine} shared by all {len(set.intersection(*tops.values()))}" \

@@ -78,8 +78,7 @@ def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int 
     for k in np.argsort(costs, kind="stable"):
         leaders.setdefault(labels[k], k)
     ranked = list(leaders.values())  # positions in ``tracking``, cheapest optimum first
-    form = form_joints(chain)
-    if per_form is not None and form.any():
+    if per_form is not None and (form := form_joints(chain)).any():
         forms = design_forms(designs[ranked], form)
         taken: dict[tuple[int, ...], int] = {}
         first = []
