@@ -324,6 +324,31 @@ def test_the_second_rounds_leaders_are_capped_per_form():
     assert "at most 1 of one form" in search.describe()
 
 
+def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
+    """``new_forms``: after the ``count`` leaders (unchanged, in order), the cheapest optimum of each form not among
+    them, cheapest first, at most that many; none when the leaders hold every form. The second round
+    (`Search.rebranch_new_forms`) starts them after the leaders' starts, which stay what they were."""
+    problem = problem_from_config(parse_config({}))
+    a, b, c = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0), (1, 0, 1, 0, 1)
+    sols = [_optimum(problem, cost, form, shift) for cost, form, shift in
+            ((1.0, a, 0.0), (2.0, a, 0.1), (3.0, b, 0.0), (4.0, b, 0.2), (5.0, a, 0.3), (6.0, c, 0.0))]
+    assert distinct_best(sols, 2, new_forms=1) == [0, 1, 2]
+    assert distinct_best(sols, 2, new_forms=2) == [0, 1, 2, 5]
+    assert distinct_best(sols, 2, new_forms=5) == [0, 1, 2, 5]
+    assert distinct_best(sols, 3, new_forms=2) == [0, 1, 2, 5]
+    assert distinct_best(sols, 6, new_forms=2) == [0, 1, 2, 3, 4, 5]
+
+    task = Task("", "explore", problem, Collocation(), SolverProfile(), Seeded(0, 0))
+    plain, added = Search(starts=4, rebranch=2), Search(starts=4, rebranch=2, rebranch_new_forms=2)
+    before = rebranched_tasks([[(task, s) for s in sols]], plain)
+    after = rebranched_tasks([[(task, s) for s in sols]], added)
+    assert [(t.start.solution, t.start.number) for t in after[:len(before)]] == [
+        (t.start.solution, t.start.number) for t in before]
+    assert [t.start.solution for t in after[len(before)::added.rebranch_starts]] == [sols[2], sols[5]]
+    assert [t.start.number for t in after] == list(range(4, 4 + 4 * added.rebranch_starts))
+    assert "up to 2 forms not among them" in added.describe()
+
+
 def test_the_search_finds_the_optimum_a_single_start_misses(milling_12):
     """The PUMA-560 placed by its yaw alone: the optimum over yaw is known by an exhaustive grid (24 yaws, the
     workpiece fixed, 2 starts each); start 0 (the configured yaw) ends in a local optimum 28 % above it, the

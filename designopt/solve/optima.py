@@ -60,12 +60,14 @@ def design_forms(designs: np.ndarray, form: np.ndarray) -> list[tuple[int, ...]]
     return [tuple(int(v) for v in row) for row in np.rint(angles / (np.pi / 2)).astype(int) % 2]
 
 
-def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int | None = None) -> list[int]:
+def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int | None = None,
+                  new_forms: int = 0) -> list[int]:
     """Indices into ``solutions`` of the best tracking solution of each of the ``count`` cheapest distinct
     optima (`cluster_designs`), cheapest first. ``per_form``: at most this many optima of one form
     (`design_forms`) before the optima of other forms, cheapest first; then, if fewer than ``count`` are taken,
     the cheapest of the rest (None: by cost alone; a design space without form joints has one form, and is
-    taken by cost alone too)."""
+    taken by cost alone too). ``new_forms``: then, beyond the ``count``, the cheapest optimum of each of up to
+    this many forms not among them, cheapest first."""
     tracking = [i for i, s in enumerate(solutions) if s.metrics.tracks]
     if not tracking or count <= 0:
         return []
@@ -78,7 +80,8 @@ def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int 
     for k in np.argsort(costs, kind="stable"):
         leaders.setdefault(labels[k], k)
     ranked = list(leaders.values())  # positions in ``tracking``, cheapest optimum first
-    if per_form is not None and (form := form_joints(chain)).any():
+    form = form_joints(chain) if per_form is not None or new_forms else None
+    if per_form is not None and form.any():
         forms = design_forms(designs[ranked], form)
         taken: dict[tuple[int, ...], int] = {}
         first = []
@@ -88,7 +91,16 @@ def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int 
                 first.append(k)
         kept = set(first)
         ranked = first + [k for k in ranked if k not in kept]
-    return [tracking[k] for k in ranked[:count]]
+    picked, rest = ranked[:count], ranked[count:]
+    if new_forms and rest and form.any():
+        seen = set(design_forms(designs[picked], form))
+        for k, f in zip(rest, design_forms(designs[rest], form), strict=True):
+            if len(picked) == count + new_forms:
+                break
+            if f not in seen:
+                seen.add(f)
+                picked.append(k)
+    return [tracking[k] for k in picked]
 
 
 def best_solution(solutions):

@@ -29,7 +29,8 @@ class Search:
     the full path for ``multistart``; for ``coarse_to_fine`` the exploration's starts on ``explore_waypoints`` of
     the path's waypoints (each capped at ``explore_max_iter``), then the ``rebranch`` best distinct of their optima
     (at most ``rebranch_per_form`` of one form, the pattern of the arm's joint axes, before other forms:
-    `optima.distinct_best`; None: by cost alone) each started again ``starts // rebranch`` times (at least once) on
+    `optima.distinct_best`; None: by cost alone), and the cheapest of each of up to ``rebranch_new_forms`` forms
+    not among them, each started again ``starts // rebranch`` times (at least once) on
     a new joint branch (the optimum's design, first joints drawn over the whole circle:
     `designopt.solve.starts.Rebranched`; 0: none), explored alike; the
     ``screen`` best distinct of both rounds are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``;
@@ -58,6 +59,7 @@ class Search:
     explore_max_iter: int = 250
     rebranch: int = 8
     rebranch_per_form: int | None = None
+    rebranch_new_forms: int = 0
     screen_waypoints: int = 40
     screen: int = 12
     screen_max_iter: int = 300
@@ -93,6 +95,8 @@ class Search:
                   if self.screen_waypoints else "")
         per_form = (f" (at most {self.rebranch_per_form} of one form)" if self.rebranch_per_form is not None
                     else "")
+        if self.rebranch_new_forms:
+            per_form += f" and the best of up to {self.rebranch_new_forms} forms not among them"
         again = (f", the best {self.rebranch} distinct{per_form} restarted {self.rebranch_starts} times each on a "
                  f"new joint branch" if self.rebranch else "")
         kkt = self.explore_linear_solver or self.profile.linear_solver

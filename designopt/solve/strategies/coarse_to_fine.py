@@ -7,7 +7,8 @@ design optimal for the full path. Stages, each across every problem:
 1. ``explore``: ``search.starts`` cold seeded starts of the *coarse problem* -- the same robot, placement, costs and
    cell on ``explore_waypoints`` of the path's waypoints (`coarse_problem`) -- each capped at
    ``explore_max_iter``. A coarse solve costs about a tenth of a full one. Then the ``rebranch`` best distinct
-   coarse optima (at most ``rebranch_per_form`` of one form, when set) are each started again ``starts //
+   coarse optima (at most ``rebranch_per_form`` of one form, when set; and the cheapest of up to
+   ``rebranch_new_forms`` forms not among them) are each started again ``starts //
    rebranch`` times with their design on a new joint branch
    (first joints over the whole circle, `Rebranched`), explored alike and pooled with the first round: a start lands in
    the best basin only when its design and its branch both fit, and good designs are where to look for branches.
@@ -78,13 +79,15 @@ def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:
 
 def rebranched_tasks(found, search) -> list[Task]:
     """For every job's exploration (its (task, solution) pairs), its ``search.rebranch`` best distinct coarse optima
-    (at most ``search.rebranch_per_form`` of one form before other forms: `optima.distinct_best`) each started
+    (at most ``search.rebranch_per_form`` of one form before other forms: `optima.distinct_best`), and the
+    cheapest of each of up to ``search.rebranch_new_forms`` forms not among them, each started
     ``search.rebranch_starts`` (``starts // rebranch``) times on a new joint branch, as the task that found it (the
     same coarse problem, profile and continuation); start indices follow the exploration's (``search.starts``
     onwards)."""
     tasks, m = [], search.rebranch_starts
     for done in found:
-        leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form)
+        leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
+                                search.rebranch_new_forms)
         for k, i in enumerate(leaders):
             first, sol = done[i]
             for j in range(m):
