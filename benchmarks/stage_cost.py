@@ -1,0 +1,53 @@
+"""What a variant's runs cost against the base runs they were replayed from, by stage, whatever the machine's load.
+
+For the runs of BASE (a directory `search_seeds.py --out DIR` keeps, DIR/<name>/s<seed>) and the same runs in
+VARIANT (`replay_stages.py --out`), this prints per stage (the exploration's two rounds apart: start index below
+or from ``search.starts``) the solves and iterations of both, and the variant's solve time estimated as its
+iterations at the base's own time per iteration in each stage: on a shared machine the solve times of two runs
+made at different moments are not comparable, their iterations are, and a stage's time per iteration does not
+depend on the variant when its problems are the same.
+
+    .venv/bin/python benchmarks/stage_cost.py DIR/milling REPLAY/milling
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pandas as pd
+
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
+
+
+def stages(run: Path) -> pd.DataFrame:
+    """A run's solves, iterations and solve time (s) per stage; ``explore2`` the exploration's second round."""
+    summary = pd.read_csv(run / "summary.csv")
+    first_round = search_from_config(load_config(run / "config.yaml")).starts
+    stage = summary["stage"].astype(str).where(
+        (summary["stage"] != "explore") | (summary["seed"] % 1000 < first_round), "explore2")
+    return summary.groupby(stage).agg(solves=("iterations", "size"), iterations=("iterations", "sum"),
+                                      seconds=("solve_time_s", "sum"))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("base", type=Path)
+    parser.add_argument("variant", type=Path)
+    args = parser.parse_args()
+    runs = sorted(p.name for p in args.base.glob("s*") if (args.variant / p.name / "summary.csv").exists())
+    base = sum(stages(args.base / r) for r in runs)
+    variant = sum(stages(args.variant / r) for r in runs).reindex(base.index, fill_value=0)
+    per_iteration = base["seconds"] / base["iterations"]
+    table = pd.DataFrame({"solves": base["solves"], "variant solves": variant["solves"],
+                          "iterations": base["iterations"], "variant iterations": variant["iterations"],
+                          "ms per iteration": 1e3 * per_iteration})
+    print(f"{len(runs)} runs")
+    print(table.to_string(float_format=lambda v: f"{v:.2f}"))
+    ratio = (variant["iterations"] * per_iteration).sum() / base["seconds"].sum()
+    print(f"variant's solve time estimated at the base's time per iteration: {ratio:.3f}x the base's")
+
+
+if __name__ == "__main__":
+    main()
