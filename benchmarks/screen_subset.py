@@ -17,17 +17,16 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from types import SimpleNamespace
 
 import pandas as pd
+from stage_solvers import solved
 
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
 from designopt.problem import problem_from_config
-from designopt.solution import read_solution_for
 from designopt.solve.optima import distinct_best
 from designopt.solve.search import Job
-from designopt.solve.strategies.coarse_to_fine import better_pass, coarse_problem, numbered_stage
+from designopt.solve.strategies.coarse_to_fine import better_pass, numbered_stage
 from designopt.tables import stage_kind
 
 
@@ -55,11 +54,8 @@ def main() -> None:
         summary = pd.read_csv(run / "summary.csv")
         kind = summary["stage"].astype(str).map(stage_kind)
         explored = summary[kind == "explore"].set_index("seed")["design_cost"]
-        rows = summary[kind == "screen"]
-        coarse = coarse_problem(job.problem, search.screen_waypoints)
-        pairs = [(SimpleNamespace(seed=int(seed), stage=stage), read_solution_for(coarse, job.transcription, run / f))
-                 for seed, stage, f in zip(rows["seed"], rows["stage"], rows["solution_file"], strict=True)]
-        order = sorted({int(s) for s in rows["seed"]}, key=lambda s: explored[s])  # the screen's candidate order
+        pairs = solved(run, job, "screen", search.screen_waypoints)
+        order = sorted({t.seed for t, _ in pairs}, key=lambda s: explored[s])  # the screen's candidate order
         full = refined(pairs, order, len(order), search.refine, search.distinct)
         refines = summary[kind == "refine"]
         if {s for s, _ in full} != {int(s) for s in refines["seed"]}:

@@ -56,12 +56,12 @@ from designopt.tables import stage_kind  # noqa: E402
 
 def solved(run: Path, job: Job, kind: str, waypoints: int) -> list[tuple[SimpleNamespace, object]]:
     """The run's solves of stage kind ``kind`` (explore: both rounds; screen: every pass) on ``waypoints`` of the
-    path, as (task with its start number, solution) pairs in start order."""
+    path, as (task with its start number and stage, solution) pairs in start order."""
     summary = pd.read_csv(run / "summary.csv")
     rows = summary[summary["stage"].astype(str).map(stage_kind) == kind].sort_values("seed", kind="stable")
     coarse = coarse_problem(job.problem, waypoints)
-    return [(SimpleNamespace(seed=int(seed)), read_solution_for(coarse, job.transcription, run / f))
-            for seed, f in zip(rows["seed"], rows["solution_file"], strict=True)]
+    return [(SimpleNamespace(seed=int(seed), stage=stage), read_solution_for(coarse, job.transcription, run / f))
+            for seed, stage, f in zip(rows["seed"], rows["stage"], rows["solution_file"], strict=True)]
 
 
 def stage_tasks(run: Path, stage: str) -> tuple[list, object]:
