@@ -46,6 +46,7 @@ from designopt.solve import (
 )
 from designopt.solve.optima import design_forms, form_joints
 from designopt.solve.starts import Rebranched
+from designopt.solve.strategies import coarse_to_fine
 from designopt.solve.strategies.coarse_to_fine import coarse_problem, rebranched_tasks
 from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import units
@@ -348,6 +349,30 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
     assert [t.start.solution for t in after[len(before)::added.rebranch_starts]] == [sols[2], sols[5]]
     assert [t.start.number for t in after] == list(range(4, 4 + 4 * added.rebranch_starts))
     assert "up to 2 forms not among them" in added.describe()
+
+
+def test_the_screen_takes_at_most_screen_per_form_of_one_form():
+    """`Search.screen_per_form`: the screen lifts the distinct coarse optima in order of cost, at most that many of
+    one form before those of other forms (`optima.distinct_best`'s ``per_form``); None: the cheapest by cost alone.
+    Driven through the search's plan: the explored solves in, the screen's starts out."""
+    problem = problem_from_config(parse_config({}))
+    a, b, c = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0), (1, 0, 1, 0, 1)
+    sols = [_optimum(problem, cost, form, shift) for cost, form, shift in
+            ((1.0, a, 0.0), (2.0, a, 0.1), (3.0, a, 0.2), (4.0, b, 0.0), (5.0, a, 0.3), (6.0, c, 0.0))]
+    job = Job("", problem)
+
+    def screened(search):
+        plan = coarse_to_fine.plan([job], search)
+        explore = next(plan)
+        assert len(explore) == len(sols)
+        return [t.start.solution for t in plan.send(list(zip(explore, sols, strict=True)))]
+
+    base = Search(starts=6, rebranch=0, screen=3, screen_waypoints=20)
+    assert problem.toolpath.n > base.screen_waypoints
+    assert screened(base) == sols[:3]
+    assert screened(replace(base, screen_per_form=1)) == [sols[0], sols[3], sols[5]]
+    assert screened(replace(base, screen_per_form=2)) == [sols[0], sols[1], sols[3]]
+    assert "at most 2 of one form" in replace(base, screen_per_form=2).describe()
 
 
 def test_the_search_finds_the_optimum_a_single_start_misses(milling_12):

@@ -33,8 +33,9 @@ class Search:
     not among them, each started again ``starts // rebranch`` times (at least once) on
     a new joint branch (the optimum's design, first joints drawn over the whole circle:
     `designopt.solve.starts.Rebranched`; 0: none), explored alike; the
-    ``screen`` best distinct of both rounds are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``;
-    skipped when the path has no more waypoints), and the
+    ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
+    cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
+    more waypoints), and the
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
     design joint are one optimum. ``hold_degenerate``: a solve stalled on a degenerate design is finished with
     the design held there (`strategies.continuation`). ``structure_neighbours``: after the strategy, one more
@@ -62,6 +63,7 @@ class Search:
     rebranch_new_forms: int = 0
     screen_waypoints: int = 40
     screen: int = 12
+    screen_per_form: int | None = None
     screen_max_iter: int = 300
     refine: int = 4
     distinct: float = 0.02
@@ -90,7 +92,8 @@ class Search:
         if self.strategy == "multistart":
             stall = f"; a TO start no closer to the path for {StalledViolation.PATIENCE} iterations is stopped"
             return f"multistart: {self.starts} seeded starts{drawn} on the full path ({cap}){stall}{held}{solver}"
-        screen = (f", the best {self.screen} distinct re-ranked on {self.screen_waypoints} waypoints "
+        capped = f" (at most {self.screen_per_form} of one form)" if self.screen_per_form is not None else ""
+        screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}, if the path has more)"
                   if self.screen_waypoints else "")
         per_form = (f" (at most {self.rebranch_per_form} of one form)" if self.rebranch_per_form is not None

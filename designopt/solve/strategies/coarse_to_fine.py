@@ -13,9 +13,10 @@ design optimal for the full path. Stages, each across every problem:
    (first joints over the whole circle, `Rebranched`), explored alike and pooled with the first round: a start lands in
    the best basin only when its design and its branch both fit, and good designs are where to look for branches.
 2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
-   optima lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter`` and ranked again there:
-   the coarse ranking alone often puts a design that lifts badly ahead of one that lifts well. Once per barrier of
-   ``screen_mu_init`` (stages ``screen``, ``screen2``, ...), each candidate ranked by its better pass.
+   optima (at most ``screen_per_form`` of one form before other forms, when set) lifted to ``screen_waypoints``
+   waypoints, solved warm within ``screen_max_iter`` and ranked again there: the coarse ranking alone often puts a
+   design that lifts badly ahead of one that lifts well. Once per barrier of ``screen_mu_init`` (stages
+   ``screen``, ``screen2``, ...), each candidate ranked by its better pass.
 3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
    once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
@@ -40,10 +41,11 @@ def coarse_problem(problem: DesignProblem, waypoints: int) -> DesignProblem:
 
 
 def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, search, max_iter: int | None = None,
-                 mu_init: float | None = None):
-    """For every job, its ``count`` best distinct solutions lifted to ``waypoints`` (None: the full path), each
-    solved warm within ``max_iter`` iterations (None: the profile's own cap), from barrier parameter ``mu_init``
-    (None: the warm start's own)."""
+                 mu_init: float | None = None, per_form: int | None = None):
+    """For every job, its ``count`` best distinct solutions (at most ``per_form`` of one form before other forms,
+    `optima.distinct_best`; None: by cost alone) lifted to ``waypoints`` (None: the full path), each solved warm
+    within ``max_iter`` iterations (None: the profile's own cap), from barrier parameter ``mu_init`` (None: the warm
+    start's own)."""
     warm = search.profile.warmed().capped(max_iter)
     if mu_init is not None:
         warm = warm.with_options(**{"ipopt.mu_init": mu_init})
@@ -51,7 +53,7 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     for job, done in zip(jobs, found, strict=True):
         problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
         profile, continuation = solve_setup(job, search, warm)
-        for i in distinct_best([sol for _, sol in done], count, search.distinct):
+        for i in distinct_best([sol for _, sol in done], count, search.distinct, per_form):
             tasks.append(Task(job.case, stage, problem, job.transcription, profile, Lifted(done[i][1]), continuation))
     return tasks
 
@@ -113,7 +115,8 @@ def plan(jobs, search):
         tasks = [task for i, screen_mu in enumerate(search.screen_mu_init)
                  for task in lifted_tasks(sub, [explored[k] for k in screened], search.screen,
                                           numbered_stage("screen", i), search.screen_waypoints, search,
-                                          search.screen_max_iter, mu_init=screen_mu)]
+                                          search.screen_max_iter, mu_init=screen_mu,
+                                          per_form=search.screen_per_form)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
