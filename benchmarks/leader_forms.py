@@ -59,7 +59,7 @@ def main() -> None:
         chain = problem.chain
         (best_form,) = forms(named(reference["design_joints"], chain), chain)
         sols = [sol for task, sol in solved(run, Job("", problem), "explore", search.explore_waypoints)
-                if task.seed % 1000 < search.starts]  # the first round's, in start order
+                if not search.second_round(task.seed)]  # the first round's, in start order
         optima = distinct_best(sols, len(sols), search.distinct)
         ordered = forms(np.array([sols[i].raw.q_d for i in optima]), chain)
         by_form = list(dict.fromkeys(ordered))

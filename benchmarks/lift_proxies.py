@@ -100,7 +100,7 @@ def main() -> None:
           f"{int((screen <= 1.05 * best).sum())} within 5 % of it")
     if args.reference:
         # the exploration's two rounds apart: seeded starts (index < starts) and rebranched ones
-        second = np.array([r["seed"] % 1000 >= search.starts for r in rows])
+        second = np.array([search.second_round(r["seed"]) for r in rows])
         for name, part in (("", np.ones_like(second)), ("  seeded starts", ~second), ("  rebranched starts", second)):
             if part.any():
                 print(f"{name or 'screened'} ({int(part.sum())}) within 1.10x / 1.20x / 1.50x of {args.reference:.4g}: "

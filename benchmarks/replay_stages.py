@@ -38,11 +38,11 @@ ROOT = Path(__file__).resolve().parent.parent
 ORDER = ("explore", "rebranch", "screen", "refine")
 
 
-def later(stage: str, number: int, start: str, first_round: int) -> bool:
+def later(stage: str, number: int, start: str, search) -> bool:
     """Whether a solve of ``stage`` with start ``number`` is of ``start`` or after it (screen2 after screen, refine2
-    after refine; an exploration start from index ``first_round`` on is the second round's)."""
+    after refine; an exploration start of the search's second round, `Search.second_round`, is ``rebranch``'s)."""
     kind = stage_kind(stage)
-    if kind == "explore" and number % 1000 >= first_round:
+    if kind == "explore" and search.second_round(number):
         kind = "rebranch"
     return kind in ORDER and ORDER.index(kind) >= ORDER.index(start)
 
@@ -50,7 +50,7 @@ def later(stage: str, number: int, start: str, first_round: int) -> bool:
 def strip(run: Path, start: str) -> int:
     """Drop the rows and solution files of ``start`` and later stages; the number of rows dropped."""
     summary = pd.read_csv(run / "summary.csv")
-    drop = dropped(summary, start, search_from_config(load_config(run / "config.yaml")).starts)
+    drop = dropped(summary, start, search_from_config(load_config(run / "config.yaml")))
     for name in summary.loc[drop, "solution_file"].dropna():
         (run / str(name)).unlink(missing_ok=True)
     summary.loc[~drop].to_csv(run / "summary.csv", index=False)
@@ -59,9 +59,9 @@ def strip(run: Path, start: str) -> int:
     return int(drop.sum())
 
 
-def dropped(summary: pd.DataFrame, start: str, first_round: int) -> pd.Series:
+def dropped(summary: pd.DataFrame, start: str, search) -> pd.Series:
     """The rows of ``summary`` of stage ``start`` and later (`later`)."""
-    return pd.Series([later(str(st), int(n), start, first_round) for st, n in
+    return pd.Series([later(str(st), int(n), start, search) for st, n in
                       zip(summary["stage"], summary["seed"], strict=True)], index=summary.index, dtype=bool)
 
 
@@ -98,8 +98,8 @@ def main() -> None:
         now = json.loads(best.read_text())["metrics"]["design_cost"] / known if best.exists() else np.inf
         before.append(was)
         after.append(now)
-        first_round = search_from_config(load_config(copy / "config.yaml")).starts
-        solved = int(dropped(pd.read_csv(copy / "summary.csv"), args.start, first_round).sum())
+        search = search_from_config(load_config(copy / "config.yaml"))
+        solved = int(dropped(pd.read_csv(copy / "summary.csv"), args.start, search).sum())
         print(f"{run}: {was:.3f} -> {now:.3f}x the best known ({n_dropped} solves dropped, {solved} solved, "
               f"{wall:.1f} s wall)", flush=True)
     b, a = np.array(before), np.array(after)

@@ -24,9 +24,9 @@ from designopt.experiments.adapters import search_from_config
 def stages(run: Path) -> pd.DataFrame:
     """A run's solves, iterations and solve time (s) per stage; ``explore2`` the exploration's second round."""
     summary = pd.read_csv(run / "summary.csv")
-    first_round = search_from_config(load_config(run / "config.yaml")).starts
+    search = search_from_config(load_config(run / "config.yaml"))
     stage = summary["stage"].astype(str).where(
-        (summary["stage"] != "explore") | (summary["seed"] % 1000 < first_round), "explore2")
+        (summary["stage"] != "explore") | ~search.second_round(summary["seed"]), "explore2")
     return summary.groupby(stage).agg(solves=("iterations", "size"), iterations=("iterations", "sum"),
                                       seconds=("solve_time_s", "sum"))
 

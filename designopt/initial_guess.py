@@ -268,9 +268,22 @@ def _point_residual(payload: bytes):
     return _InPlace(ca.Function("tracking_residual_q", args, [ca.densify(r), ca.densify(J_q)]))
 
 
+STARTS_PER_SEED = 1000  # a start's number: seed * STARTS_PER_SEED + index
+
+
+def start_number(seed: int, index: int) -> int:
+    """The number of start ``index`` of ``seed``: what identifies it in a run's files (summary.csv's seed)."""
+    return seed * STARTS_PER_SEED + index
+
+
+def start_index(number):
+    """The index of the start numbered ``number`` (an int or an array of them) within its seed's starts."""
+    return number % STARTS_PER_SEED
+
+
 def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik",
                   design: np.ndarray | None = None, spread: str = "perturb") -> InitialGuess:
-    """Start ``index`` of a seeded multistart (seed * 1000 + index). Start 0 keeps the configured design; the
+    """Start ``index`` of a seeded multistart (numbered `start_number`). Start 0 keeps the configured design; the
     others perturb it by ``scale`` (``spread`` perturb: first joints within +-pi/2) or draw it from the task's
     box (``spread`` box, `box_design`: first joints over the whole circle, so that folded postures are
     reached); ``spread`` mixed: odd starts as box, even ones as perturb. ``design`` (if given) is the start design
@@ -290,7 +303,7 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
         q_d = perturbed_design(problem, rng, scale) if spread == "perturb" else box_design(problem, rng)
     q0 = random_configuration(problem, rng, np.pi / 2 if spread == "perturb" else np.pi)
     if mode == "constant":
-        return InitialGuess(q_d=q_d, Q=np.tile(q0, (problem.toolpath.n, 1)), seed=seed * 1000 + index)
+        return InitialGuess(q_d=q_d, Q=np.tile(q0, (problem.toolpath.n, 1)), seed=start_number(seed, index))
     Q = ik_trajectory(problem, q_d, q0)
     if mode == "reach" and problem.chain.n_design and not tracks(problem, q_d, Q):
         # first the design, from a few waypoints spread along the path; then the walk with it; then, if some
@@ -300,7 +313,7 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
         Q = ik_trajectory(problem, q_d, q0)
         if not tracks(problem, q_d, Q):
             q_d, Q = reach(problem, q_d, Q)
-    return InitialGuess(q_d=q_d, Q=Q, seed=seed * 1000 + index)
+    return InitialGuess(q_d=q_d, Q=Q, seed=start_number(seed, index))
 
 
 def design_from(problem: DesignProblem, other: DesignProblem, q_d_other: np.ndarray) -> np.ndarray:

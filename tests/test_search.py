@@ -349,6 +349,13 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
     assert [t.start.solution for t in after[len(before)::added.rebranch_starts]] == [sols[2], sols[5]]
     assert [t.start.number for t in after] == list(range(4, 4 + 4 * added.rebranch_starts))
     assert "up to 2 forms not among them" in added.describe()
+    # a start's number tells the rounds apart, as the benchmarks read them back from a run's files
+    seeded = seeded_tasks(Job("", problem), "explore", problem, SolverProfile(), replace(added, seed=7), added.starts)
+    rebranched = rebranched_tasks([[(task, s) for s in sols]], replace(added, seed=7))
+    assert not any(added.second_round(t.seed) for t in seeded)
+    assert all(added.second_round(t.seed) for t in rebranched)
+    assert list(added.second_round(np.array([t.seed for t in seeded + rebranched]))) == (
+        [False] * len(seeded) + [True] * len(rebranched))
 
 
 def test_the_screen_takes_at_most_screen_per_form_of_one_form():

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
+from designopt.initial_guess import start_index
 from designopt.problem import DesignProblem
 from designopt.solution import Solution
 from designopt.solve.observers import StalledViolation
@@ -78,6 +79,11 @@ class Search:
     def rebranch_starts(self) -> int:
         """Starts on new joint branches per rebranched optimum: the second round as large as the first."""
         return max(1, self.starts // self.rebranch) if self.rebranch else 0
+
+    def second_round(self, number):
+        """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,
+        on a new joint branch: its index (`initial_guess.start_index`) from ``starts`` on (`rebranched_tasks`)."""
+        return start_index(number) >= self.starts
 
     def describe(self) -> str:
         """The search in words."""

@@ -2,8 +2,9 @@
 coarse optimum's design on a new joint branch (`Rebranched`), or a solution of a structure with one joint fewer
 (`Grown`).
 
-Every start has a ``number`` that identifies it in a run's files (the seed column of summary.csv): seed * 1000 +
-index for a seeded, rebranched or grown start, the lifted solution's number for a lifted one.
+Every start has a ``number`` that identifies it in a run's files (the seed column of summary.csv):
+`initial_guess.start_number` (seed * 1000 + index) for a seeded, rebranched or grown start, the lifted solution's
+number for a lifted one.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from designopt.initial_guess import design_named, initial_guess, projected
+from designopt.initial_guess import design_named, initial_guess, projected, start_number
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
@@ -33,7 +34,7 @@ class Seeded:
 
     @property
     def number(self) -> int:
-        return self.seed * 1000 + self.index
+        return start_number(self.seed, self.index)
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
         return initial_guess(problem, self.index, self.seed, self.scale, self.init, self.design, self.spread)
@@ -68,7 +69,7 @@ class Rebranched:
 
     @property
     def number(self) -> int:
-        return self.seed * 1000 + self.index
+        return start_number(self.seed, self.index)
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
         # with a design given, spread "box" only sets the first joints' range: the whole circle
@@ -92,7 +93,7 @@ class Grown:
 
     @property
     def number(self) -> int:
-        return self.seed * 1000 + self.index
+        return start_number(self.seed, self.index)
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
         return grown_guess(problem, self.source, self.solution, self.where, self.number)
