@@ -1,0 +1,82 @@
+"""Where a search finds the best design's basin: which screened candidates land in it, and whether the refine keeps it.
+
+A default run screens its 24 best distinct coarse optima on 40 waypoints (twice, `Search.screen_mu_init`) and
+refines the best 4 of those. A screen *lands* when its design cost on the 40 waypoints is within ``--within`` of
+the best design known (by default 1.05x). For each RUN (a directory `search_seeds.py --out DIR` keeps,
+DIR/<name>/s<seed>), this reads the screened candidates back (their coarse optima: form, `leader_forms.forms`;
+rank among the run's tracking coarse optima by cost; round, `Search.second_round`) and prints, over all runs, the
+screens and landings per form, per coarse rank and per round, and the runs where a screen landed but the answer
+did not (a landing the refine lost). Nothing is solved.
+
+    .venv/bin/python benchmarks/screen_landings.py DIR/circle_standoff/s* \
+        --reference benchmarks/reference/circle_standoff_best_known.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from leader_forms import forms
+from stage_solvers import solved
+
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
+from designopt.problem import problem_from_config
+from designopt.solve.search import Job
+from designopt.tables import stage_kind
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def screens(run: Path, known: float, within: float) -> pd.DataFrame:
+    """One row per screen solve of ``run``: its start, whether it landed, its candidate's form, coarse rank and
+    round; ``answer_landed`` whether the run's answer is within ``within`` of ``known`` too."""
+    cfg = load_config(run / "config.yaml")
+    search = search_from_config(cfg)
+    problem = problem_from_config(cfg)
+    summary = pd.read_csv(run / "summary.csv")
+    kind = summary["stage"].astype(str).map(stage_kind)
+    explored = {task.seed: sol for task, sol in solved(run, Job("", problem), "explore", search.explore_waypoints)}
+    tracking = summary[(kind == "explore") & summary["tracks"].astype(bool)].sort_values("design_cost", kind="stable")
+    rank = {int(s): k for k, s in enumerate(tracking["seed"])}
+    screened = summary[kind == "screen"]
+    seeds = [int(s) for s in screened["seed"]]
+    form = forms(np.array([explored[s].raw.q_d for s in seeds]), problem.chain) if seeds else []
+    final = summary[(kind == "refine") & summary["tracks"].astype(bool)]
+    answer = final["design_cost"].min() if len(final) else np.inf
+    return pd.DataFrame({
+        "run": run.name, "start": seeds, "form": form, "rank": [rank.get(s) for s in seeds],
+        "second_round": [bool(search.second_round(s)) for s in seeds],
+        "landed": (screened["design_cost"] <= within * known).to_numpy() & screened["tracks"].astype(bool).to_numpy(),
+        "answer_landed": answer <= within * known})
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("runs", nargs="+", type=Path)
+    parser.add_argument("--reference", required=True, help="the best design known (a solution file)")
+    parser.add_argument("--within", type=float, default=1.05, help="a landing: screened cost <= this x the best known")
+    args = parser.parse_args()
+    known = json.loads((ROOT / args.reference).read_text())["metrics"]["design_cost"]
+    rows = pd.concat([screens(run, known, args.within) for run in args.runs], ignore_index=True)
+    print(f"{len(rows)} screens of {len(args.runs)} runs, {int(rows['landed'].sum())} landed within {args.within}x "
+          f"of the best known ({known:.4g}); runs with a landing: {rows.groupby('run')['landed'].any().sum()}")
+    tally = lambda by: rows.groupby(by)["landed"].agg(landed="sum", screens="size")  # noqa: E731
+    print("\nper form of the candidate (most screened first):")
+    print(tally("form").sort_values("screens", ascending=False).to_string())
+    print("\nper coarse rank of the candidate (among the run's tracking coarse optima, 0 the cheapest):")
+    print(tally(pd.cut(rows["rank"], [-1, 3, 7, 15, 31, 10**6], labels=["0-3", "4-7", "8-15", "16-31", "32+"]))
+          .to_string())
+    print("\nper round of the exploration (True: the second, on new joint branches):")
+    print(tally("second_round").to_string())
+    lost = rows.groupby("run").agg(landed=("landed", "any"), answer=("answer_landed", "first"))
+    lost = lost[lost["landed"] & ~lost["answer"]]
+    print(f"\nruns whose screen landed but whose answer did not: {len(lost)} ({', '.join(lost.index) or 'none'})")
+
+
+if __name__ == "__main__":
+    main()
