@@ -73,6 +73,16 @@ def main() -> None:
           .to_string())
     print("\nper round of the exploration (True: the second, on new joint branches):")
     print(tally("second_round").to_string())
+    # per candidate (any of its screens landed), ranked by coarse cost within its run and form, the landing forms only
+    cand = rows.groupby(["run", "start"], as_index=False).agg(form=("form", "first"), rank=("rank", "first"),
+                                                              landed=("landed", "any"))
+    landing = cand.groupby("form")["landed"].sum()
+    cand = cand[cand["form"].isin(landing[landing > 2].index)].copy()
+    cand["within"] = cand.groupby(["run", "form"])["rank"].rank(method="first") - 1
+    print(f"\ncandidates of the forms that landed more than twice ({', '.join(sorted(set(cand['form'])))}), per rank "
+          "within their form and run (0 the cheapest):")
+    print(cand.groupby(pd.cut(cand["within"], [-1, 0, 1, 3, 7, 10**6], labels=["0", "1", "2-3", "4-7", "8+"]))[
+        "landed"].agg(landed="sum", candidates="size").to_string())
     lost = rows.groupby("run").agg(landed=("landed", "any"), answer=("answer_landed", "first"))
     lost = lost[lost["landed"] & ~lost["answer"]]
     print(f"\nruns whose screen landed but whose answer did not: {len(lost)} ({', '.join(lost.index) or 'none'})")
