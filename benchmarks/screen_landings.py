@@ -20,13 +20,11 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from leader_forms import forms
-from stage_solvers import solved
+from leader_forms import forms, named
 
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
 from designopt.problem import problem_from_config
-from designopt.solve.search import Job
 from designopt.tables import stage_kind
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -37,15 +35,18 @@ def screens(run: Path, known: float, within: float) -> pd.DataFrame:
     round; ``answer_landed`` whether the run's answer is within ``within`` of ``known`` too."""
     cfg = load_config(run / "config.yaml")
     search = search_from_config(cfg)
-    problem = problem_from_config(cfg)
+    chain = problem_from_config(cfg).chain
     summary = pd.read_csv(run / "summary.csv")
     kind = summary["stage"].astype(str).map(stage_kind)
-    explored = {task.seed: sol for task, sol in solved(run, Job("", problem), "explore", search.explore_waypoints)}
-    tracking = summary[(kind == "explore") & summary["tracks"].astype(bool)].sort_values("design_cost", kind="stable")
-    rank = {int(s): k for k, s in enumerate(tracking["seed"])}
+    explored = summary[kind == "explore"].set_index("seed")
+    tracking = explored[explored["tracks"].astype(bool)].sort_values("design_cost", kind="stable")
+    rank = {int(s): k for k, s in enumerate(tracking.index)}
     screened = summary[kind == "screen"]
     seeds = [int(s) for s in screened["seed"]]
-    form = forms(np.array([explored[s].raw.q_d for s in seeds]), problem.chain) if seeds else []
+    # only the screened candidates' coarse optima are read (their design joints), not the whole exploration
+    design = {s: named(json.loads((run / explored.loc[s, "solution_file"]).read_text())["design_joints"], chain)
+              for s in set(seeds)}
+    form = forms(np.array([design[s] for s in seeds]), chain) if seeds else []
     final = summary[(kind == "refine") & summary["tracks"].astype(bool)]
     answer = final["design_cost"].min() if len(final) else np.inf
     return pd.DataFrame({
