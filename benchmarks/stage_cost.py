@@ -1,11 +1,11 @@
 """What a variant's runs cost against the base runs they were replayed from, by stage, whatever the machine's load.
 
 For the runs of BASE (a directory `search_seeds.py --out DIR` keeps, DIR/<name>/s<seed>) and the same runs in
-VARIANT (`replay_stages.py --out`), this prints per stage (the exploration's two rounds apart: start index below
-or from ``search.starts``) the solves and iterations of both, and the variant's solve time estimated as its
-iterations at the base's own time per iteration in each stage: on a shared machine the solve times of two runs
-made at different moments are not comparable, their iterations are, and a stage's time per iteration does not
-depend on the variant when its problems are the same.
+VARIANT (`replay_stages.py --out`), this prints per stage (the exploration's two rounds apart,
+`Search.second_round`) the solves and iterations of both, and the variant's solve time estimated as its iterations
+at the base's own time per iteration in each stage: on a shared machine the solve times of two runs made at
+different moments are not comparable, their iterations are, and a stage's time per iteration does not depend on
+the variant when its problems are the same.
 
     .venv/bin/python benchmarks/stage_cost.py DIR/milling REPLAY/milling
 """
