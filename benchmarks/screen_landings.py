@@ -4,8 +4,9 @@ A default run screens its 24 best distinct coarse optima on 40 waypoints (twice,
 refines the best 4 of those. A screen *lands* when its design cost on the 40 waypoints is within ``--within`` of
 the best design known (by default 1.05x). For each RUN (a directory `search_seeds.py --out DIR` keeps,
 DIR/<name>/s<seed>), this reads the screened candidates back (their coarse optima: form, `leader_forms.forms`;
-rank among the run's tracking coarse optima by cost; round, `Search.second_round`) and prints, over all runs, the
-screens and landings per form, per coarse rank and per round, and the runs where a screen landed but the answer
+rank among the run's tracking coarse optima by cost; coarse cost over the best known; round,
+`Search.second_round`) and prints, over all runs, the screens and landings per form, per coarse rank, per coarse
+cost and per round, and the runs where a screen landed but the answer
 did not (a landing the refine lost). Nothing is solved.
 
     .venv/bin/python benchmarks/screen_landings.py DIR/circle_standoff/s* \
@@ -31,8 +32,8 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def screens(run: Path, known: float, within: float) -> pd.DataFrame:
-    """One row per screen solve of ``run``: its start, whether it landed, its candidate's form, coarse rank and
-    round; ``answer_landed`` whether the run's answer is within ``within`` of ``known`` too."""
+    """One row per screen solve of ``run``: its start, whether it landed, its candidate's form, coarse rank, coarse
+    cost over ``known`` and round; ``answer_landed`` whether the run's answer is within ``within`` of ``known`` too."""
     cfg = load_config(run / "config.yaml")
     search = search_from_config(cfg)
     chain = problem_from_config(cfg).chain
@@ -51,6 +52,7 @@ def screens(run: Path, known: float, within: float) -> pd.DataFrame:
     answer = final["design_cost"].min() if len(final) else np.inf
     return pd.DataFrame({
         "run": run.name, "start": seeds, "form": form, "rank": [rank.get(s) for s in seeds],
+        "coarse": explored.loc[seeds, "design_cost"].to_numpy() / known,
         "second_round": [bool(search.second_round(s)) for s in seeds],
         "landed": (screened["design_cost"] <= within * known).to_numpy() & screened["tracks"].astype(bool).to_numpy(),
         "answer_landed": answer <= within * known})
@@ -72,6 +74,8 @@ def main() -> None:
     print("\nper coarse rank of the candidate (among the run's tracking coarse optima, 0 the cheapest):")
     print(tally(pd.cut(rows["rank"], [-1, 3, 7, 15, 31, 10**6], labels=["0-3", "4-7", "8-15", "16-31", "32+"]))
           .to_string())
+    print("\nper coarse cost of the candidate (its exploration optimum's design cost / the best known):")
+    print(tally(pd.cut(rows["coarse"], [0, 1.1, 1.3, 1.6, 2, 3, np.inf])).to_string())
     print("\nper round of the exploration (True: the second, on new joint branches):")
     print(tally("second_round").to_string())
     # per candidate (any of its screens landed), ranked by coarse cost within its run and form, the landing forms only
