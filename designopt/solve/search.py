@@ -159,8 +159,9 @@ PRESETS: dict[str, Search] = {
     # not among them): on seeds 1341-1360 (main job) and 1321-1340 (the other two), replays from the second round,
     # seeds better / worse 3 / 0, 0 / 0, 5 / 0 (the circle 5 -> 8 within 1.10x), about 1.07x the solve time; 4 forms
     # instead of 2 changed no answer on seeds 1361-1380 / 1341-1360, and neither did a cap of 6 candidates of one form
-    # on the screen (`screen_per_form`: 1 seed better, 3 worse) (docs/benchmarks.md, "Search"; docs/decisions.md,
-    # 2026-11-26/27)
+    # on the screen (`screen_per_form`: 1 seed better, 3 worse), nor 36 screened instead of 24 on the main job and the
+    # circle (seeds 1381-1400 / 1361-1380; physical stiffness 2 better, at 1.16-1.18x the solve time)
+    # (docs/benchmarks.md, "Search"; docs/decisions.md, 2026-11-26/27)
     "default": Search(starts=160, screen=24, explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
                       refine_mu_init=(None, 1e-6), rebranch_new_forms=2),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
