@@ -27,7 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from stage_cost import stages
+from replay_stages import answer, quartiles
+from stage_cost import common_runs, compared
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -61,17 +62,6 @@ def verdict(base: np.ndarray, variant: np.ndarray, time_ratio: float, rule: Rule
     return not failed, failed
 
 
-def answer(run: Path, known: float) -> float:
-    """A run's best design cost over ``known`` (inf when the run has no answer)."""
-    best = run / "best.json"
-    return json.loads(best.read_text())["metrics"]["design_cost"] / known if best.exists() else np.inf
-
-
-def distribution(a: np.ndarray) -> str:
-    return (f"{a.min():.3f} / {np.median(a):.3f} / {np.quantile(a, 0.9):.3f} / {a.max():.3f}, "
-            f"{int((a <= 1.10).sum())} of {len(a)} within 1.10x")
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("base", type=Path)
@@ -84,20 +74,17 @@ def main() -> None:
     args = parser.parse_args()
     rule = Rule(args.margin, args.hold, args.time, args.strictly_better)
     known = json.loads((ROOT / args.reference).read_text())["metrics"]["design_cost"]
-    runs = sorted(p.name for p in args.base.glob("s*") if (args.variant / p.name / "summary.csv").exists())
+    runs = common_runs(args.base, args.variant)
     if not runs:
         sys.exit(f"{args.base}, {args.variant}: no run in both")
     base = np.array([answer(args.base / r, known) for r in runs])
     variant = np.array([answer(args.variant / r, known) for r in runs])
-    cost_base = sum(stages(args.base / r) for r in runs)
-    cost_variant = sum(stages(args.variant / r) for r in runs).reindex(cost_base.index, fill_value=0)
-    per_iteration = cost_base["seconds"] / cost_base["iterations"]
-    time_ratio = float((cost_variant["iterations"] * per_iteration).sum() / cost_base["seconds"].sum())
+    _, time_ratio = compared(args.base, args.variant, runs)
     moved = [f"{r} {b:.3f} -> {v:.3f}" for r, b, v in zip(runs, base, variant, strict=True)
              if abs(np.log(v / b)) > np.log1p(rule.margin)]
     print(f"{len(runs)} seeds ({runs[0]}-{runs[-1]}), against the best known {known:.4g}")
-    print(f"base:    {distribution(base)}")
-    print(f"variant: {distribution(variant)}")
+    print(f"base:    {quartiles(base)}")
+    print(f"variant: {quartiles(variant)}")
     print(f"seeds moved by more than {rule.margin:.1%}: {', '.join(moved) or 'none'}")
     print(f"solve time: {time_ratio:.3f}x the base's (its iterations at the base's time per iteration per stage)")
     passed, failed = verdict(base, variant, time_ratio, rule)

@@ -65,6 +65,12 @@ def dropped(summary: pd.DataFrame, start: str, search) -> pd.Series:
                       zip(summary["stage"], summary["seed"], strict=True)], index=summary.index, dtype=bool)
 
 
+def answer(run: Path, known: float) -> float:
+    """A run's best design cost over ``known`` (inf when the run has no answer)."""
+    best = run / "best.json"
+    return json.loads(best.read_text())["metrics"]["design_cost"] / known if best.exists() else np.inf
+
+
 def quartiles(a: np.ndarray) -> str:
     return (f"{a.min():.3f} / {np.median(a):.3f} / {np.percentile(a, 90):.3f} / {a.max():.3f}, "
             f"{int((a <= 1.10).sum())} of {len(a)} within 1.10x")
@@ -93,9 +99,7 @@ def main() -> None:
         wall = time.perf_counter() - t0
         if done.returncode not in (0, 3):
             sys.exit(f"{run}: designopt run --resume exited {done.returncode}: {done.stderr.strip()}")
-        was = json.loads((run / "best.json").read_text())["metrics"]["design_cost"] / known
-        best = copy / "best.json"
-        now = json.loads(best.read_text())["metrics"]["design_cost"] / known if best.exists() else np.inf
+        was, now = answer(run, known), answer(copy, known)
         before.append(was)
         after.append(now)
         search = search_from_config(load_config(copy / "config.yaml"))

@@ -31,21 +31,31 @@ def stages(run: Path) -> pd.DataFrame:
                                       seconds=("solve_time_s", "sum"))
 
 
+def common_runs(base: Path, variant: Path) -> list[str]:
+    """The runs (s<seed>) both directories hold."""
+    return sorted(p.name for p in base.glob("s*") if (variant / p.name / "summary.csv").exists())
+
+
+def compared(base: Path, variant: Path, runs: list[str]) -> tuple[pd.DataFrame, float]:
+    """Per stage, the solves and iterations of ``runs`` in ``base`` and ``variant`` and the base's ms per
+    iteration; and the variant's solve time estimated at those times per iteration, over the base's."""
+    b = sum(stages(base / r) for r in runs)
+    v = sum(stages(variant / r) for r in runs).reindex(b.index, fill_value=0)
+    per_iteration = b["seconds"] / b["iterations"]
+    table = pd.DataFrame({"solves": b["solves"], "variant solves": v["solves"], "iterations": b["iterations"],
+                          "variant iterations": v["iterations"], "ms per iteration": 1e3 * per_iteration})
+    return table, float((v["iterations"] * per_iteration).sum() / b["seconds"].sum())
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("base", type=Path)
     parser.add_argument("variant", type=Path)
     args = parser.parse_args()
-    runs = sorted(p.name for p in args.base.glob("s*") if (args.variant / p.name / "summary.csv").exists())
-    base = sum(stages(args.base / r) for r in runs)
-    variant = sum(stages(args.variant / r) for r in runs).reindex(base.index, fill_value=0)
-    per_iteration = base["seconds"] / base["iterations"]
-    table = pd.DataFrame({"solves": base["solves"], "variant solves": variant["solves"],
-                          "iterations": base["iterations"], "variant iterations": variant["iterations"],
-                          "ms per iteration": 1e3 * per_iteration})
+    runs = common_runs(args.base, args.variant)
+    table, ratio = compared(args.base, args.variant, runs)
     print(f"{len(runs)} runs")
     print(table.to_string(float_format=lambda v: f"{v:.2f}"))
-    ratio = (variant["iterations"] * per_iteration).sum() / base["seconds"].sum()
     print(f"variant's solve time estimated at the base's time per iteration: {ratio:.3f}x the base's")
 
 
