@@ -50,9 +50,9 @@ def setup(config: str, waypoints: int, stage: str, options: tuple = (), compile_
     problem, search = problem_from_config(cfg), search_from_config(cfg)
     if waypoints:
         problem = coarse_problem(problem, waypoints)
-    if stage == "explore":
+    if stage == "explore":  # as the search explores: capped, watched, by the exploration's linear solver
         profile = search.profile.observing("degenerate").capped(search.explore_max_iter)
-        search = replace(search, profile=profile)
+        search = replace(search, profile=profile.solved_by(search.explore_linear_solver))
     if options:
         search = replace(search, profile=replace(search.profile, options=(*search.profile.options, *options)))
     if compile_mode:
