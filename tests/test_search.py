@@ -524,7 +524,12 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     assert barriers == {"explore": None, "screen": None, "screen2": 1e-7, "refine": None, "refine2": 1e-6}
     starts = {stage: sorted(t.seed for t, _ in done if t.stage == stage)
               for stage in ("screen", "screen2", "refine", "refine2")}
-    assert starts["screen"] == starts["screen2"] and len(starts["screen"]) == 3
+    # as many candidates as the exploration found distinct tracking optima, up to 3 (its 4 starts end in 2 or 3
+    # distinct optima, depending on the machine's libm: the solves are chaotic in their last bits)
+    explored = [(t, s) for t, s in done if t.stage == "explore"]
+    candidates = distinct_best([s for _, s in explored], search.screen, search.distinct)
+    assert starts["screen"] == starts["screen2"] == sorted(explored[i][0].seed for i in candidates)
+    assert len(candidates) >= 2
     assert starts["refine"] == starts["refine2"] and len(starts["refine"]) == 1
     # the refines start from the cheapest of every screened solve, from either barrier
     screened = [s for t, s in done if t.stage in ("screen", "screen2") and s.metrics.tracks]
@@ -637,13 +642,14 @@ def test_a_stalled_violation_stops_a_solve_and_a_falling_or_feasible_one_never()
 
 
 def test_a_cold_start_that_stalls_off_the_path_stops_with_its_status(milling_12, monkeypatch):
-    """The placement alone is designed, from 1.5 m away: IPOPT gets within 3-4 cm of the path, stays there and
-    declares the problem infeasible after ~200 iterations; the watch stops it once it has stalled for its patience,
-    having lost nothing (neither tracks)."""
+    """The placement alone is designed, from 2 m away: IPOPT gets within centimetres of the path, stays there and
+    declares the problem infeasible after ~300 iterations; the watch stops it once it has stalled for its patience
+    (here after ~90), having lost nothing (neither tracks). From 1.5 m the approach is slower and, on some
+    machines' libm, still falling by half every 80 iterations when IPOPT gives up (173 iterations): no stall."""
     from designopt.solve.observers import StalledViolation
 
     cfg = copy.deepcopy(milling_12)
-    cfg["design"], cfg["placement"]["xyz"] = ["placement"], [1.5, 0.0, -0.2]
+    cfg["design"], cfg["placement"]["xyz"] = ["placement"], [2.0, 0.0, -0.2]
     problem = problem_from_config(parse_config(cfg))
     guess = initial_guess(problem, 0, 0, 0.3)
     free = solve_guess(problem, Collocation(), SolverProfile(max_iter=1500), guess)
