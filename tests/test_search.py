@@ -358,33 +358,6 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
         [False] * len(seeded) + [True] * len(rebranched))
 
 
-def test_the_second_round_can_add_more_than_one_optimum_of_each_new_form():
-    """``per_new_form``: after the cheapest of each new form, the second cheapest of each (in the same form order),
-    and so on; the default's leaders and added ones keep their starts, the deeper ones follow
-    (`Search.rebranch_per_new_form`)."""
-    problem = problem_from_config(parse_config({}))
-    a, b, c = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0), (1, 0, 1, 0, 1)
-    sols = [_optimum(problem, cost, form, shift) for cost, form, shift in
-            ((1.0, a, 0.0), (2.0, a, 0.1), (3.0, b, 0.0), (4.0, b, 0.2), (5.0, a, 0.3), (6.0, c, 0.0),
-             (7.0, c, 0.2), (8.0, b, 0.4))]
-    assert distinct_best(sols, 2, new_forms=2) == [0, 1, 2, 5]
-    assert distinct_best(sols, 2, new_forms=2, per_new_form=2) == [0, 1, 2, 5, 3, 6]
-    assert distinct_best(sols, 2, new_forms=2, per_new_form=3) == [0, 1, 2, 5, 3, 6, 7]
-    assert distinct_best(sols, 2, new_forms=1, per_new_form=2) == [0, 1, 2, 3]
-    assert distinct_best(sols, 2, per_new_form=2) == [0, 1]  # no new forms asked for
-
-    task = Task("", "explore", problem, Collocation(), SolverProfile(), Seeded(0, 0))
-    one = Search(starts=4, rebranch=2, rebranch_new_forms=2)
-    two = replace(one, rebranch_per_new_form=2)
-    before = rebranched_tasks([[(task, s) for s in sols]], one)
-    after = rebranched_tasks([[(task, s) for s in sols]], two)
-    assert [(t.start.solution, t.start.number) for t in after[:len(before)]] == [
-        (t.start.solution, t.start.number) for t in before]
-    assert [t.start.solution for t in after[len(before)::two.rebranch_starts]] == [sols[3], sols[6]]
-    assert [t.start.number for t in after] == list(range(4, 4 + 6 * two.rebranch_starts))
-    assert "the best 2 of each of up to 2 forms not among them" in two.describe()
-
-
 def test_the_screen_takes_at_most_screen_per_form_of_one_form():
     """`Search.screen_per_form`: the screen lifts the distinct coarse optima in order of cost, at most that many of
     one form before those of other forms (`optima.distinct_best`'s ``per_form``); None: the cheapest by cost alone.

@@ -61,14 +61,13 @@ def design_forms(designs: np.ndarray, form: np.ndarray) -> list[tuple[int, ...]]
 
 
 def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int | None = None,
-                  new_forms: int = 0, per_new_form: int = 1) -> list[int]:
+                  new_forms: int = 0) -> list[int]:
     """Indices into ``solutions`` of the best tracking solution of each of the ``count`` cheapest distinct
     optima (`cluster_designs`), cheapest first. ``per_form``: at most this many optima of one form
     (`design_forms`) before the optima of other forms, cheapest first; then, if fewer than ``count`` are taken,
     the cheapest of the rest (None: by cost alone; a design space without form joints has one form, and is
     taken by cost alone too). ``new_forms``: then, beyond the ``count``, the cheapest optimum of each of up to
-    this many forms not among them, cheapest first; ``per_new_form``: then the second cheapest optimum of each of
-    those forms (in the same order), and so on, up to this many of each."""
+    this many forms not among them, cheapest first."""
     tracking = [i for i, s in enumerate(solutions) if s.metrics.tracks]
     if not tracking or count <= 0:
         return []
@@ -95,16 +94,12 @@ def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int 
     picked, rest = ranked[:count], ranked[count:]
     if new_forms and rest and form.any():
         seen = set(design_forms(designs[picked], form))
-        added: dict[tuple[int, ...], list[int]] = {}  # each new form's optima, cheapest first
         for k, f in zip(rest, design_forms(designs[rest], form), strict=True):
-            if f in seen:
-                continue
-            if f not in added and len(added) == new_forms:
-                continue
-            if len(added.setdefault(f, [])) < per_new_form:
-                added[f].append(k)
-        for depth in range(per_new_form):
-            picked += [ks[depth] for ks in added.values() if depth < len(ks)]
+            if len(picked) == count + new_forms:
+                break
+            if f not in seen:
+                seen.add(f)
+                picked.append(k)
     return [tracking[k] for k in picked]
 
 

@@ -31,8 +31,7 @@ class Search:
     the path's waypoints (each capped at ``explore_max_iter``), then the ``rebranch`` best distinct of their optima
     (at most ``rebranch_per_form`` of one form, the pattern of the arm's joint axes, before other forms:
     `optima.distinct_best`; None: by cost alone), and the cheapest of each of up to ``rebranch_new_forms`` forms
-    not among them (then the next cheapest of each, up to ``rebranch_per_new_form`` of a form), each started again
-    ``starts // rebranch`` times (at least once) on
+    not among them, each started again ``starts // rebranch`` times (at least once) on
     a new joint branch (the optimum's design, first joints drawn over the whole circle:
     `designopt.solve.starts.Rebranched`; 0: none), explored alike; the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
@@ -63,7 +62,6 @@ class Search:
     rebranch: int = 8
     rebranch_per_form: int | None = None
     rebranch_new_forms: int = 0
-    rebranch_per_new_form: int = 1
     screen_waypoints: int = 40
     screen: int = 12
     screen_per_form: int | None = None
@@ -107,8 +105,7 @@ class Search:
         per_form = (f" (at most {self.rebranch_per_form} of one form)" if self.rebranch_per_form is not None
                     else "")
         if self.rebranch_new_forms:
-            best = "the best" if self.rebranch_per_new_form == 1 else f"the best {self.rebranch_per_new_form} of each"
-            per_form += f" and {best} of up to {self.rebranch_new_forms} forms not among them"
+            per_form += f" and the best of up to {self.rebranch_new_forms} forms not among them"
         again = (f", the best {self.rebranch} distinct{per_form} restarted {self.rebranch_starts} times each on a "
                  f"new joint branch" if self.rebranch else "")
         kkt = self.explore_linear_solver or self.profile.linear_solver

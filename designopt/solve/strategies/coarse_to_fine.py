@@ -82,15 +82,14 @@ def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:
 def rebranched_tasks(found, search) -> list[Task]:
     """For every job's exploration (its (task, solution) pairs), its ``search.rebranch`` best distinct coarse optima
     (at most ``search.rebranch_per_form`` of one form before other forms: `optima.distinct_best`), and the
-    cheapest of each of up to ``search.rebranch_new_forms`` forms not among them (up to
-    ``search.rebranch_per_new_form`` of each, the cheapest of every form first), each started
+    cheapest of each of up to ``search.rebranch_new_forms`` forms not among them, each started
     ``search.rebranch_starts`` (``starts // rebranch``) times on a new joint branch, as the task that found it (the
     same coarse problem, profile and continuation); start indices follow the exploration's (``search.starts``
     onwards)."""
     tasks, m = [], search.rebranch_starts
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
-                                search.rebranch_new_forms, search.rebranch_per_new_form)
+                                search.rebranch_new_forms)
         for k, i in enumerate(leaders):
             first, sol = done[i]
             for j in range(m):
