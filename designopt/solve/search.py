@@ -48,7 +48,11 @@ class Search:
     each candidate refined once per value (stages ``refine``, ``refine2``, ...; the answer is the best of all): from
     a small one a refine stays in the basin its screened start is in, from the warm start's it sometimes walks
     into a better one and more often into a worse one. ``screen_mu_init``: the same for the screen (stages
-    ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass.
+    ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``reflect``: then up to
+    this many rounds (stages ``reflect``, ``reflect2``, ...) in which the best full-path solution is reflected
+    across each of its length bounds it lies within ``REFLECT_WITHIN`` of (`kinematics.reflections.at_bound`: the
+    same arm with that length's sign flipped, pushed ``distinct`` across; `starts.Reflected`) and solved warm from
+    barrier ``REFLECT_MU_INIT``, while a round lowers the best design cost by more than ``REFLECT_GAIN``; 0: none.
     """
 
     strategy: str = "coarse_to_fine"
@@ -74,6 +78,7 @@ class Search:
     explore_linear_solver: str | None = None
     screen_mu_init: tuple[float | None, ...] = (None,)
     refine_mu_init: tuple[float | None, ...] = (None,)
+    reflect: int = 0
 
     @property
     def rebranch_starts(self) -> int:
@@ -111,9 +116,21 @@ class Search:
         kkt = self.explore_linear_solver or self.profile.linear_solver
         kkt = f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
         barrier = _barriers(self.refine_mu_init)
+        reflect = (f", then the best reflected across its length bounds (up to {self.reflect} rounds)" if self.reflect
+                   else "")
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
-                f"refined on the full path ({cap}{barrier}){held}{solver}")
+                f"refined on the full path ({cap}{barrier}){reflect}{held}{solver}")
+
+
+# The reflect stage (`Search.reflect`): a length within REFLECT_WITHIN (m) of its lower bound of 0 is reflected (the
+# main job's answers that stop at a bound hold it within 1e-8 m; those that sit near 0 by the arm's own symmetry at
+# about 7e-4 m, and their reflections come back to them), each reflected start solved warm from barrier
+# REFLECT_MU_INIT (it stays in the basin it is given, as a refine from 1e-6 does), rounds going on while the best
+# design cost falls by more than REFLECT_GAIN (a fraction)
+REFLECT_WITHIN = 0.01
+REFLECT_MU_INIT = 1e-6
+REFLECT_GAIN = 1e-3
 
 
 def _barriers(mu_init: tuple[float | None, ...]) -> str:

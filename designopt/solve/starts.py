@@ -1,6 +1,6 @@
 """Where a solve starts: a seeded start (`Seeded`), a solution of another sampling of the same task (`Lifted`), a
-coarse optimum's design on a new joint branch (`Rebranched`), or a solution of a structure with one joint fewer
-(`Grown`).
+coarse optimum's design on a new joint branch (`Rebranched`), a solution of a structure with one joint fewer
+(`Grown`), or a solution written with one length's sign flipped and pushed across its bound (`Reflected`).
 
 Every start has a ``number`` that identifies it in a run's files (the seed column of summary.csv):
 `initial_guess.start_number` (seed * 1000 + index) for a seeded, rebranched or grown start, the lifted solution's
@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from designopt.initial_guess import design_named, initial_guess, projected, start_number
+from designopt.kinematics.reflections import Reflection
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
@@ -75,6 +76,32 @@ class Rebranched:
         # with a design given, spread "box" only sets the first joints' range: the whole circle
         return initial_guess(problem, self.index, self.seed, 0.0, self.init, np.asarray(self.solution.raw.q_d, float),
                              "box")
+
+
+@dataclass(frozen=True, eq=False)
+class Reflected:
+    """A full-path solution reflected across a length bound (`designopt.kinematics.reflections`): the same arm and
+    motion written with that length's sign flipped, then the length pushed ``step`` (m) past its bound of 0 -- the
+    side the bound had closed -- and each waypoint moved onto the path with that design (`projected`). ``seed`` and
+    ``index`` number it."""
+
+    solution: object  # designopt.solution.Solution
+    reflection: Reflection
+    step: float
+    seed: int
+    index: int
+
+    @property
+    def number(self) -> int:
+        return start_number(self.seed, self.index)
+
+    def guess(self, problem: DesignProblem) -> InitialGuess:
+        chain, t = problem.chain, problem.toolpath.t
+        q_d = self.reflection.design(chain, self.solution.raw.q_d)
+        q_d[self.reflection.length(chain)] = chain.design[self.reflection.length(chain)].lower + self.step
+        Q = self.reflection.joints(chain, self.solution.sample(t))
+        V = self.reflection.velocities(chain, self.solution.sample_velocity(t))
+        return InitialGuess(q_d=q_d, Q=projected(problem, q_d, Q), V=V, seed=self.number)
 
 
 @dataclass(frozen=True, eq=False)

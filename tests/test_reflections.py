@@ -1,0 +1,148 @@
+"""Reflections of a DH arm (`designopt.kinematics.reflections`) and the search's reflect stage.
+
+Independent truth: forward kinematics and the geometric Jacobian of the chain itself (the same arm must put the tool
+in the same place, with the same axis and compliance), a reflection applied twice is the identity, and on a problem
+whose optimum is known a design held at a length bound is carried back to it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from designopt.config import parse_config
+from designopt.initial_guess import projected
+from designopt.kinematics.chain import geometric_jacobian, tool_pose
+from designopt.kinematics.reflections import Reflection, at_bound, reflections, wrap
+from designopt.problem import problem_from_config
+from designopt.solve.local import solve_guess
+from designopt.solve.profile import SolverProfile
+from designopt.solve.search import Job, Search
+from designopt.solve.strategies import run_search
+from designopt.solve.tasks import run_task
+from designopt.transcriptions import Collocation
+from designopt.transcriptions.base import InitialGuess
+
+ROOT = Path(__file__).resolve().parent.parent
+CHAIN = problem_from_config(parse_config({})).chain  # 6R, every d, a, alpha and the placement designed
+
+
+def test_every_reflection_of_a_designed_dh_arm_is_listed():
+    """d-reflections of links 2-6 (link 1's would turn the placement), a-reflections of links 1-6; none when the
+    twists are not design joints or the chain has no DH table."""
+    assert [r.name for r in reflections(CHAIN)] == [f"link{j}.d" for j in range(2, 7)] + [
+        f"link{i}.a" for i in range(1, 7)]
+    lengths_only = problem_from_config(parse_config({"design": ["d", "a"]})).chain
+    assert reflections(lengths_only) == []
+    assert reflections(replace(CHAIN, dh=None)) == []
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_a_reflected_arm_is_the_same_arm(seed):
+    """For a random design and configuration, each reflection leaves the tool pose as it was (the last link's
+    a-reflection turns the tool frame by pi about its own z axis: the tool point and axis stay), and the
+    compliance J J^T too; applied twice, it gives the design back, and the joints up to whole turns."""
+    rng = np.random.default_rng(seed)
+    design = CHAIN.design
+    q_d = np.array([rng.uniform(max(j.lower, -1.0), min(j.upper, 1.0)) for j in design])
+    q_m = rng.uniform(-np.pi, np.pi, CHAIN.n_moving)
+    T, J = tool_pose(CHAIN, q_m, q_d), geometric_jacobian(CHAIN, q_m, q_d)
+    for r in reflections(CHAIN):
+        q_d2 = r.design(CHAIN, q_d)
+        q_m2 = r.joints(CHAIN, q_m[None, :])[0]
+        T2, J2 = tool_pose(CHAIN, q_m2, q_d2), geometric_jacobian(CHAIN, q_m2, q_d2)
+        np.testing.assert_allclose(T2[:3, 3], T[:3, 3], atol=1e-12, err_msg=r.name)
+        np.testing.assert_allclose(T2[:3, 2], T[:3, 2], atol=1e-12, err_msg=r.name)
+        turned = r.name == "link6.a"
+        np.testing.assert_allclose(T2[:3, :2], -T[:3, :2] if turned else T[:3, :2], atol=1e-12, err_msg=r.name)
+        np.testing.assert_allclose(J2 @ J2.T, J @ J.T, atol=1e-12, err_msg=r.name)
+        assert q_d2[r.length(CHAIN)] == -q_d[r.length(CHAIN)]
+        angles = np.array([j.kind == "angle" for j in design])
+        assert np.all(np.abs(q_d2[angles]) <= np.pi)
+        back = r.design(CHAIN, q_d2)
+        np.testing.assert_allclose(wrap(back - q_d), 0.0, atol=1e-12)
+        np.testing.assert_allclose(wrap(r.joints(CHAIN, q_m2[None, :])[0] - q_m), 0.0, atol=1e-12)
+        V = rng.standard_normal((3, CHAIN.n_moving))
+        np.testing.assert_allclose(np.abs(r.velocities(CHAIN, V)), np.abs(V))
+
+
+def test_a_reflection_that_would_turn_a_joint_out_of_its_bounds_does_not_apply():
+    """An a-reflection turns theta by pi whichever way stays within the joint's bounds (+-2 pi), none if neither."""
+    r = Reflection("a", 2)
+    Q = np.zeros((3, 6))
+    Q[:, 1] = [-1.9 * np.pi, 0.0, 1.9 * np.pi]  # a half turn either way leaves +-2 pi somewhere
+    assert r.joints(CHAIN, Q) is None
+    Q[:, 1] = [-1.5, 0.0, 1.5]
+    Q[:, 2] = [1.5 * np.pi, 1.6 * np.pi, 1.7 * np.pi]
+    turned = r.joints(CHAIN, Q)
+    np.testing.assert_allclose(turned[:, 1], Q[:, 1] + np.pi)
+    np.testing.assert_allclose(turned[:, 2], Q[:, 2] - np.pi)
+
+
+def test_only_lengths_near_their_bound_of_zero_are_reflected():
+    q_d = CHAIN.design_values.copy()
+    names = [j.name for j in CHAIN.design]
+    q_d[[names.index(n) for n in ("link2.d", "link3.d", "link4.d", "link5.d", "link6.d")]] = [0.0, 0.005, 0.02, 0.3,
+                                                                                                0.01]
+    q_d[[names.index(f"link{i}.a") for i in range(1, 7)]] = [0.2, 0.2, 1e-9, 0.2, 0.2, 0.2]
+    assert [r.name for r in at_bound(CHAIN, q_d, 0.01)] == ["link2.d", "link3.d", "link6.d", "link3.a"]
+
+
+# the main job's best design known (rounded): its link 4 offset d4 = 0.149 m; the same arm with link 4 d-reflected
+# needs d4 = -0.149 m, which the bound d >= 0 forbids
+BEST_DH = [(0.0007, 0.1800, -0.0038), (0.0007, 0.1901, 0.0016), (0.0007, 0.1007, -1.5735), (0.1489, 0.1884, -0.0044),
+           (0.1489, 0.0697, 1.5715), (0.0021, 0.0958, -1.5725)]
+BEST_Q0 = [0.05, 2.99, 2.89, 3.14, -3.14, -1.28]  # its first configuration
+
+
+def _held_problem():
+    """The main job on 12 waypoints with the best design known's DH table, only link 3's twist, link 4's d and twist
+    and the placement designed."""
+    cfg = yaml.safe_load((ROOT / "configs" / "milling.yaml").read_text())
+    cfg["toolpath"]["waypoints"] = 12
+    cfg["robot"]["dh"] = [{"theta": 0.0, "d": d, "a": a, "alpha": al} for d, a, al in BEST_DH]
+    cfg["placement"]["xyz"], cfg["placement"]["ypr"] = [0.0707, 0.2189, 0.0023], [1.5016, 0.0040, -1.5723]
+    cfg["design"] = ["link3.alpha", "link4.d", "link4.alpha", "placement"]
+    return problem_from_config(parse_config(cfg))
+
+
+def test_a_design_held_at_a_length_bound_is_reflected_back_to_its_optimum():
+    """From the best design known's own basin, the optimum of the held problem; from its link-4 d-reflection with d4
+    clipped to the bound, a worse optimum with d4 at the bound. The reflect stage (`Search.reflect`) reflects that
+    solution's d4 and solves warm: it reaches the optimum (the same design cost and design), and a second round
+    from the new best has nothing at a bound to reflect, so the stage ends there."""
+    problem = _held_problem()
+    chain, t = problem.chain, problem.toolpath.t
+    profile = SolverProfile(max_iter=500).warmed()
+    walk = projected(problem, chain.design_values, np.tile(BEST_Q0, (len(t), 1)))
+    optimum = solve_guess(problem, Collocation(), profile, InitialGuess(q_d=chain.design_values, Q=walk))
+    d4 = Reflection("d", 4)
+    q_d = d4.design(chain, optimum.raw.q_d)
+    q_d[d4.length(chain)] = 0.0
+    Q = d4.joints(chain, optimum.sample(t))
+    held = solve_guess(problem, Collocation(), profile, InitialGuess(q_d=q_d, Q=projected(problem, q_d, Q)))
+    assert optimum.metrics.tracks and held.metrics.tracks
+    assert held.metrics.design_cost > 1.2 * optimum.metrics.design_cost
+    assert [r.name for r in at_bound(chain, held.raw.q_d, 0.01)] == ["link4.d"]
+
+    def execute(tasks):  # the explore and refine stages end where the held solve did; the reflect stage solves
+        return [(task, run_task(task) if task.stage.startswith("reflect") else held) for task in tasks]
+
+    stages = []
+    search = Search(starts=2, explore_waypoints=6, rebranch=0, screen_waypoints=0, refine=1, reflect=3,
+                    structure_neighbours=False, profile=SolverProfile(max_iter=500))
+    (searched,) = run_search([Job("", problem)], search, lambda tasks: stages.append(tasks) or execute(tasks))
+    assert [{task.stage for task in tasks} for tasks in stages] == [{"explore"}, {"refine"}, {"reflect"}]
+    assert [task.start.reflection.name for task in stages[-1]] == ["link4.d"]
+    best = searched.best[1]
+    assert best is not held
+    np.testing.assert_allclose(best.metrics.design_cost, optimum.metrics.design_cost, rtol=1e-5)
+    np.testing.assert_allclose(best.raw.q_d, optimum.raw.q_d, atol=1e-4)
+    assert "reflected across its length bounds (up to 3 rounds)" in search.describe()
+    assert "reflected" not in replace(search, reflect=0).describe()
