@@ -19,6 +19,7 @@ import pandas as pd
 
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
+from designopt.tables import is_coarse
 
 
 def stages(run: Path) -> pd.DataFrame:
@@ -38,10 +39,17 @@ def common_runs(base: Path, variant: Path) -> list[str]:
 
 def compared(base: Path, variant: Path, runs: list[str]) -> tuple[pd.DataFrame, float]:
     """Per stage, the solves and iterations of ``runs`` in ``base`` and ``variant`` and the base's ms per
-    iteration; and the variant's solve time estimated at those times per iteration, over the base's."""
-    b = sum(stages(base / r) for r in runs)
-    v = sum(stages(variant / r) for r in runs).reindex(b.index, fill_value=0)
-    per_iteration = b["seconds"] / b["iterations"]
+    iteration; and the variant's solve time estimated at those times per iteration, over the base's. A full-path
+    stage the base does not have (a variant's new one, e.g. ``reflect``) is priced at the base's refine (the same
+    problem, solved warm)."""
+    b, v = (pd.concat([stages(d / r) for r in runs]).groupby(level=0).sum() for d in (base, variant))
+    new = [s for s in v.index if s not in b.index]
+    if any(is_coarse(s) for s in new):
+        raise ValueError(f"the base has no stage to price the variant's {new} by")
+    index = list(b.index) + new
+    b, v = b.reindex(index, fill_value=0), v.reindex(index, fill_value=0)
+    per_iteration = (b["seconds"] / b["iterations"]).where(~b.index.isin(new), b.at["refine", "seconds"]
+                                                           / b.at["refine", "iterations"])
     table = pd.DataFrame({"solves": b["solves"], "variant solves": v["solves"], "iterations": b["iterations"],
                           "variant iterations": v["iterations"], "ms per iteration": 1e3 * per_iteration})
     return table, float((v["iterations"] * per_iteration).sum() / b["seconds"].sum())
