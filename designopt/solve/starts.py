@@ -97,8 +97,8 @@ class Reflected:
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
         chain, t = problem.chain, problem.toolpath.t
-        q_d = self.reflection.design(chain, self.solution.raw.q_d)
-        q_d[self.reflection.length(chain)] = chain.design[self.reflection.length(chain)].lower + self.step
+        q_d, k = self.reflection.design(chain, self.solution.raw.q_d), self.reflection.length(chain)
+        q_d[k] = chain.design[k].lower + self.step
         Q = self.reflection.joints(chain, self.solution.sample(t))
         V = self.reflection.velocities(chain, self.solution.sample_velocity(t))
         return InitialGuess(q_d=q_d, Q=projected(problem, q_d, Q), V=V, seed=self.number)

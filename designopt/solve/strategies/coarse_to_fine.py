@@ -128,7 +128,7 @@ def plan(jobs, search):
                for task in lifted_tasks(jobs, candidates, search.refine, numbered_stage("refine", i), None, search,
                                         mu_init=refine_mu)]
     final = by_job(jobs, (yield refines))
-    reflected = [None] * len(jobs)  # per job, the solution last reflected
+    reflected = [None] * len(jobs)  # per job, the best solution the last round looked at
     for i in range(search.reflect):
         bests = [best_solution([sol for _, sol in done]) for done in final]
         tasks = reflected_tasks([(job, best) for job, best, last in zip(jobs, bests, reflected, strict=True)
@@ -137,7 +137,7 @@ def plan(jobs, search):
             break
         more = by_job(jobs, (yield tasks))
         final = [done + new for done, new in zip(final, more, strict=True)]
-        reflected = [best if new else last for best, new, last in zip(bests, more, reflected, strict=True)]
+        reflected = bests
         gained = [best_solution([sol for _, sol in done]) for done in final]
         if not any(b is not None and g.metrics.design_cost < (1 - REFLECT_GAIN) * b.metrics.design_cost
                    for b, g in zip(bests, gained, strict=True)):
