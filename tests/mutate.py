@@ -119,7 +119,7 @@ MUTATIONS = [
              "q[k] = wrap(q[k] + turn)", "q[k] = q[k] + turn", ("tests/test_reflections.py",)),
     Mutation("every length reflected, near its bound or not (reflect)", "designopt/kinematics/reflections.py",
              "q_d[k] - design[k].lower <= within", "True", ("tests/test_reflections.py",)),
-    Mutation("the reflect stage never runs (Search.reflect ignored)", "designopt/solve/strategies/coarse_to_fine.py",
+    Mutation("the reflect stage never runs (Search.reflect ignored)", "designopt/solve/strategies/reflect.py",
              "for i in range(search.reflect):", "for i in range(0):", ("tests/test_reflections.py",)),
     Mutation("the screen's candidates by cost alone (screen_per_form ignored)",
              "designopt/solve/strategies/coarse_to_fine.py", "per_form=search.screen_per_form)", "per_form=None)",

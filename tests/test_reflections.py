@@ -11,6 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pytest
 import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -112,11 +113,12 @@ def _held_problem():
     return problem_from_config(parse_config(cfg))
 
 
-def test_a_design_held_at_a_length_bound_is_reflected_back_to_its_optimum():
+@pytest.mark.parametrize("strategy", ["coarse_to_fine", "multistart"])
+def test_a_design_held_at_a_length_bound_is_reflected_back_to_its_optimum(strategy):
     """From the best design known's own basin, the optimum of the held problem; from its link-4 d-reflection with d4
-    clipped to the bound, a worse optimum with d4 at the bound. The reflect stage (`Search.reflect`) reflects that
-    solution's d4 and solves warm: it reaches the optimum (the same design cost and design), and a second round
-    from the new best has nothing at a bound to reflect, so the stage ends there."""
+    clipped to the bound, a worse optimum with d4 at the bound. The reflect step (`Search.reflect`), after either
+    strategy, reflects that solution's d4 and solves warm: it reaches the optimum (the same design cost and design),
+    and a second round from the new best has nothing at a bound to reflect, so the step ends there."""
     problem = _held_problem()
     chain, t = problem.chain, problem.toolpath.t
     profile = SolverProfile(max_iter=500).warmed()
@@ -135,10 +137,11 @@ def test_a_design_held_at_a_length_bound_is_reflected_back_to_its_optimum():
         return [(task, run_task(task) if task.stage.startswith("reflect") else held) for task in tasks]
 
     stages = []
-    search = Search(starts=2, explore_waypoints=6, rebranch=0, screen_waypoints=0, refine=1, reflect=3,
-                    structure_neighbours=False, profile=SolverProfile(max_iter=500))
+    search = Search(strategy=strategy, starts=2, explore_waypoints=6, rebranch=0, screen_waypoints=0, refine=1,
+                    reflect=3, profile=SolverProfile(max_iter=500))
     (searched,) = run_search([Job("", problem)], search, lambda tasks: stages.append(tasks) or execute(tasks))
-    assert [{task.stage for task in tasks} for tasks in stages] == [{"explore"}, {"refine"}, {"reflect"}]
+    before = [{"explore"}, {"refine"}] if strategy == "coarse_to_fine" else [{"start"}]
+    assert [{task.stage for task in tasks} for tasks in stages] == [*before, {"reflect"}]
     assert [task.start.reflection.name for task in stages[-1]] == ["link4.d"]
     best = searched.best[1]
     assert best is not held

@@ -48,11 +48,10 @@ class Search:
     each candidate refined once per value (stages ``refine``, ``refine2``, ...; the answer is the best of all): from
     a small one a refine stays in the basin its screened start is in, from the warm start's it sometimes walks
     into a better one and more often into a worse one. ``screen_mu_init``: the same for the screen (stages
-    ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``reflect``: then up to
-    this many rounds (stages ``reflect``, ``reflect2``, ...) in which the best full-path solution is reflected
-    across each of its length bounds it lies within ``REFLECT_WITHIN`` of (`kinematics.reflections.at_bound`: the
-    same arm with that length's sign flipped, pushed ``distinct`` across; `starts.Reflected`) and solved warm from
-    barrier ``REFLECT_MU_INIT``, while a round lowers the best design cost by more than ``REFLECT_GAIN``; 0: none.
+    ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``reflect``: after the
+    strategy and the neighbour step, up to this many rounds (stages ``reflect``, ``reflect2``, ...) in which each
+    problem's best full-path solution is reflected across the length bounds it lies at (the same arm with that
+    length's sign flipped) and solved warm (`strategies.reflect`); 0: none.
     """
 
     strategy: str = "coarse_to_fine"
@@ -100,9 +99,12 @@ class Search:
         cap = f"<= {self.profile.max_iter} iterations"
         drawn = {"perturb": "", "box": " drawn from the task's box",
                  "mixed": " (every other one drawn from the task's box)"}[self.spread]
+        reflect = (f", then the best reflected across its length bounds (up to {self.reflect} rounds)" if self.reflect
+                   else "")
         if self.strategy == "multistart":
             stall = f"; a TO start no closer to the path for {StalledViolation.PATIENCE} iterations is stopped"
-            return f"multistart: {self.starts} seeded starts{drawn} on the full path ({cap}){stall}{held}{solver}"
+            return (f"multistart: {self.starts} seeded starts{drawn} on the full path ({cap}){stall}{reflect}{held}"
+                    f"{solver}")
         capped = f" (at most {self.screen_per_form} of one form)" if self.screen_per_form is not None else ""
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}, if the path has more)"
@@ -116,23 +118,9 @@ class Search:
         kkt = self.explore_linear_solver or self.profile.linear_solver
         kkt = f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
         barrier = _barriers(self.refine_mu_init)
-        reflect = (f", then the best reflected across its length bounds (up to {self.reflect} rounds)" if self.reflect
-                   else "")
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){reflect}{held}{solver}")
-
-
-# The reflect stage (`Search.reflect`): a length within REFLECT_WITHIN (m) of its lower bound of 0 is reflected, each
-# reflected start solved warm from barrier REFLECT_MU_INIT (it stays in the basin it is given, as a refine from 1e-6
-# does), rounds going on while the best design cost falls by more than REFLECT_GAIN (a fraction). Over 330 reflect
-# solves of 40 runs (main job and physical stiffness, lengths within 0.01 m reflected): of the lengths within 1e-5 m
-# of the bound 17 of 17 gained (up to 9 %), within 1e-5-1e-4 m 18 of 68, further out 14 of 247, mostly by < 0.2 %
-# (a length that sits near 0 by the arm's own symmetry, at about 7e-4 m, comes back to it): 1e-4 m keeps a quarter of
-# the solves and the gains that matter (docs/decisions.md)
-REFLECT_WITHIN = 1e-4
-REFLECT_MU_INIT = 1e-6
-REFLECT_GAIN = 1e-3
 
 
 def _barriers(mu_init: tuple[float | None, ...]) -> str:

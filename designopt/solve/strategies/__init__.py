@@ -2,8 +2,9 @@
 
 A strategy module has ``plan(jobs, search)``, a generator that yields one stage's tasks for every job, receives
 their (task, solution) pairs, and at the end returns one `Searched` per job. Adding a strategy is a module here
-and a line in `STRATEGIES`. Two steps serve every strategy: `continuation` (finishing a solve stalled on a
-degenerate design) and `neighbours` (starts from a neighbouring structure's better design).
+and a line in `STRATEGIES`. Three steps serve every strategy: `continuation` (finishing a solve stalled on a
+degenerate design), then, after the strategy, `neighbours` (starts from a neighbouring structure's better design)
+and `reflect` (each best reflected across the length bounds it lies at).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from collections.abc import Callable
 
 from designopt.solution import Solution
 from designopt.solve.search import Job, Search, Searched
-from designopt.solve.strategies import coarse_to_fine, multistart, neighbours
+from designopt.solve.strategies import coarse_to_fine, multistart, neighbours, reflect
 from designopt.solve.tasks import Task
 
 STRATEGIES = {"multistart": multistart, "coarse_to_fine": coarse_to_fine}
@@ -31,6 +32,8 @@ def run_search(jobs: list[Job], search: Search, execute: Execute) -> list[Search
     searched = _drive(STRATEGIES[search.strategy].plan(jobs, search), execute)
     if search.structure_neighbours:
         searched = _drive(neighbours.plan(searched, search), execute)
+    if search.reflect:
+        searched = _drive(reflect.plan(searched, search), execute)
     return searched
 
 

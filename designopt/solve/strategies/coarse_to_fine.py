@@ -20,21 +20,16 @@ design optimal for the full path. Stages, each across every problem:
 3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
    once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
-4. ``reflect`` (``search.reflect`` rounds at most; stages ``reflect``, ``reflect2``, ...): the best full-path
-   solution reflected across each length bound it lies at (`kinematics.reflections`: the same arm with that
-   length's sign flipped, the length pushed across) and solved warm; a bound of the parametrisation, not of the
-   arm, is what often holds a refined design. The next round reflects the new best, while a round lowers it.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
 
-from designopt.kinematics.reflections import at_bound
 from designopt.problem import DesignProblem
 from designopt.solve.optima import best_solution, distinct_best
-from designopt.solve.search import REFLECT_GAIN, REFLECT_MU_INIT, REFLECT_WITHIN, Searched, by_job
-from designopt.solve.starts import Lifted, Rebranched, Reflected
+from designopt.solve.search import Searched, by_job
+from designopt.solve.starts import Lifted, Rebranched
 from designopt.solve.strategies.steps import seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
@@ -128,41 +123,5 @@ def plan(jobs, search):
                for task in lifted_tasks(jobs, candidates, search.refine, numbered_stage("refine", i), None, search,
                                         mu_init=refine_mu)]
     final = by_job(jobs, (yield refines))
-    reflected = [None] * len(jobs)  # per job, the best solution the last round looked at
-    for i in range(search.reflect):
-        bests = [best_solution([sol for _, sol in done]) for done in final]
-        tasks = reflected_tasks([(job, best) for job, best, last in zip(jobs, bests, reflected, strict=True)
-                                 if best is not None and best is not last], numbered_stage("reflect", i), search)
-        if not tasks:
-            break
-        more = by_job(jobs, (yield tasks))
-        final = [done + new for done, new in zip(final, more, strict=True)]
-        reflected = bests
-        gained = [best_solution([sol for _, sol in done]) for done in final]
-        if not any(b is not None and g.metrics.design_cost < (1 - REFLECT_GAIN) * b.metrics.design_cost
-                   for b, g in zip(bests, gained, strict=True)):
-            break
     return [Searched(job, e, f) for job, e, f in zip(jobs, explored, final, strict=True)]
-
-
-REFLECTED_FROM = 900  # the first start index of a reflect stage's starts (`Reflected`)
-
-
-def reflected_tasks(bests, stage: str, search) -> list[Task]:
-    """For every (job, best full-path solution), a task per length of that solution within ``REFLECT_WITHIN`` of its
-    bound of 0 whose reflection keeps the motion within the joints' bounds (`kinematics.reflections.at_bound`),
-    starting from the solution reflected and pushed ``search.distinct`` across (`Reflected`), solved warm on the
-    full path from barrier ``REFLECT_MU_INIT``. Start indices from 900 on (after any exploration's)."""
-    warm = search.profile.warmed().with_options(**{"ipopt.mu_init": REFLECT_MU_INIT})
-    tasks = []
-    for job, best in bests:
-        chain = job.problem.chain
-        profile, continuation = solve_setup(job, search, warm)
-        Q = best.sample(job.problem.toolpath.t)
-        for k, reflection in enumerate(at_bound(chain, best.raw.q_d, REFLECT_WITHIN)):
-            if reflection.joints(chain, Q) is None:
-                continue
-            start = Reflected(best, reflection, search.distinct, search.seed, REFLECTED_FROM + k)
-            tasks.append(Task(job.case, stage, job.problem, job.transcription, profile, start, continuation))
-    return tasks
 
