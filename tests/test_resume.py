@@ -95,9 +95,12 @@ def test_run_resumes(tmp_path):
     again = runner.invoke(app, ["run", str(config), "--out", str(out), "--name", "k"])
     assert again.exit_code == 2 and "--resume" in again.output  # never overwrites a run silently
     result = runner.invoke(app, ["run", str(config), "--out", str(out), "--name", "k", "--resume", "--no-figures"])
-    refined = {k for k in read_summary(run / "summary.csv")[KEY].itertuples(index=False, name=None) if k[1] == "refine"}
+    keys = set(read_summary(run / "summary.csv")[KEY].itertuples(index=False, name=None))
+    refined = {k for k in keys if k[1] == "refine"}
     assert 1 <= len(refined) <= 2  # the best two distinct coarse optima, refined on the full path
-    after = check_resumed(run, before, {("", "explore", "to", "RRRRRR", s) for s in range(5)} | refined, result)
+    reflected = {k for k in keys if k[1].startswith("reflect")}  # the best reflected across its length bounds, if any
+    after = check_resumed(run, before, {("", "explore", "to", "RRRRRR", s) for s in range(5)} | refined | reflected,
+                          result)
     assert after["best"].sum() == 1 and (run / "best.json").is_file()
 
 
