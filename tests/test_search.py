@@ -75,7 +75,7 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert task.start.spread == "box"
     assert "drawn from the task's box" in boxed.describe() and "box" not in PRESETS["default"].describe()
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
-    assert preset("quick", seed=2) == Search(starts=40, rebranch=0, refine=2, reflect=3, seed=2,
+    assert preset("quick", seed=2) == Search(starts=40, rebranch=0, refine=4, reflect=3, seed=2,
                                              profile=PRESETS["quick"].profile)
 
 

@@ -160,8 +160,8 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
     assert set(summary["structure"]) == {"R", "P", "RR", "RP", "PR", "PP"}
     assert (summary["case"] == "sweep").all()
     stages = summary.groupby(["structure", "stage"]).size()
-    for s in ("RR", "RP", "PR", "PP"):  # every structure gets the same search: 3 coarse starts, the best 2 refined
-        assert stages[s, "explore"] == 3 and stages.get((s, "refine"), 0) <= 2
+    for s in ("RR", "RP", "PR", "PP"):  # every structure gets the same search: 3 coarse starts, the best 4 refined
+        assert stages[s, "explore"] == 3 and stages.get((s, "refine"), 0) <= 3  # (of 3 coarse optima at most)
     # a structure gets a neighbour's start exactly when a neighbour (one joint type changed, or one joint fewer)
     # searched its way to a cheaper design than its own, one start per such neighbour (and insertion)
     refined = summary[summary["stage"] == "refine"]

@@ -144,14 +144,17 @@ DEGENERATE_JACOBIAN = (*REGULARISED_CONSTRAINTS, ("ipopt.alpha_for_y", "min-dual
 PAPER = Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0))
 
 PRESETS: dict[str, Search] = {
-    # a structure sweep's per-structure search: half the default's starts and refinements, tighter caps, no second
+    # a structure sweep's per-structure search: a quarter of the default's starts, tighter caps, no second
     # round on new joint branches (on the K = I sweep it took 1.5x the wall, moved the structure bests both ways and
     # reached 5 instead of 8 of 10 references: its extra coarse optima crowd out, of the 2 refined, the ones that
     # lift well; docs/decisions.md), and IPOPT set for degenerate Jacobians (most of a sweep's structures have fewer
     # than six joints or prismatic ones). Each structure's best reflected across its length bounds after the neighbour
     # starts (`reflect`): on the K = I sweep's fresh seeds 2101 and 2102, 42 and 36 more solves (0.7 % and 0.6 % of
-    # the sweep's solver time) lowered 8 and 7 structure bests by more than 1 % (up to 0.73x), none higher
-    "quick": Search(starts=40, rebranch=0, refine=2, reflect=3,
+    # the sweep's solver time) lowered 8 and 7 structure bests by more than 1 % (up to 0.73x), none higher. The best 4
+    # distinct coarse optima refined, not 2: on seeds 2101-2103 (replays from the refine on), references within 1.10x
+    # 6 -> 6, 5 -> 7, 3 -> 4 of 10; structure bests lower / higher by > 1 % 22 / 2, 21 / 6, 15 / 8; at 1.20x, 1.17x
+    # and 1.09x the solver time (docs/benchmarks.md, "Sweep")
+    "quick": Search(starts=40, rebranch=0, refine=4, reflect=3,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
     # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against
