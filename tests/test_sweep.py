@@ -101,8 +101,9 @@ def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_des
 
     def searched(structure, cost):
         job = Job("sweep", problem_from_config(parse_config({"robot": {"dh": "generic", "structure": structure}})))
+        moving = np.linspace(0.0, 1.0, 6)[:, None] * np.ones(len(structure))  # every joint moves
         sol = SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
-                              raw=SimpleNamespace(q_d=job.problem.chain.design_values, objective=1.5 * cost))
+                              raw=SimpleNamespace(q_d=job.problem.chain.design_values, objective=1.5 * cost, Q=moving))
         return Searched(job, [], [(SimpleNamespace(), sol)])
 
     plan = neighbour_stage.plan([searched("RRP", shorter_cost), searched("RRRP", 2.0)], preset("quick"))
@@ -114,6 +115,85 @@ def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_des
     # each is held to its structure's best: stopped if still above 3x its objective (1.5 * 2.0) after 300 iterations
     assert all(t.bound == Bound(pytest.approx(3 * 1.5 * 2.0), 300) and "above_bound" in t.profile.observers
                for t in tasks)
+
+
+def _structure_problem(structure):
+    """A structure of the sweep's config: every link parameter but the joint's and the placement designed."""
+    from designopt.experiments.adapters import structure_config
+    from designopt.problem import problem_from_config
+
+    return problem_from_config(structure_config(load_config(Path(__file__).parent.parent / "configs" /
+                                                            "structures.yaml"), structure))
+
+
+@pytest.mark.parametrize("big", ["RRRP", "PRRR", "PRRRRR", "RPPRRP"])
+def test_a_pruned_start_keeps_the_longer_structures_tool_path(big):
+    """The invariant behind `Pruned`: a structure whose first joint stays still is the structure without it, placed
+    by the still link's transform: with that link carried into the placement, the tool is where it was in the
+    workpiece frame at every waypoint (the shorter structure's own kinematics, no shared code path)."""
+    from types import SimpleNamespace
+
+    from designopt.initial_guess import initial_guess
+    from designopt.kinematics.chain import tool_in_workpiece
+    from designopt.solve.starts import pruned_design
+
+    source, target = _structure_problem(big), _structure_problem(big[1:])
+    checked = 0
+    for seed in range(6):
+        guess = initial_guess(source, seed, 7, 0.3)  # a perturbed design and some joint values (tracking or not)
+        Q = guess.Q.copy()
+        Q[:, 0] = Q[0, 0]  # the first joint held
+        solution = SimpleNamespace(raw=SimpleNamespace(q_d=guess.q_d, Q=Q))
+        q_d = pruned_design(target, source, solution)
+        if q_d is None:  # the carried placement leaves its bounds
+            continue
+        checked += 1
+        for q in Q:
+            assert np.allclose(np.asarray(tool_in_workpiece(target.chain, q[1:], q_d), float),
+                               np.asarray(tool_in_workpiece(source.chain, q, guess.q_d), float), atol=1e-10)
+    assert checked >= 3
+    with pytest.raises(ValueError, match="without its first joint"):
+        pruned_design(_structure_problem("RR"), source, solution)
+
+
+def test_a_pruned_start_whose_placement_leaves_its_bounds_is_not_given():
+    """The placement that carries the still link can fall outside the placement's box: no start then."""
+    from types import SimpleNamespace
+
+    from designopt.solve.starts import pruned_design
+
+    source, target = _structure_problem("PRR"), _structure_problem("RR")
+    q_d = source.chain.design_values.copy()
+    names = [j.name for j in source.chain.design]
+    q_d[names.index("link1.theta")], q_d[names.index("placement.x")] = 0.0, 1.9
+    Q = np.zeros((4, 3))
+    Q[:, 0] = 0.5  # the prismatic first joint held 0.5 m out, along the base z axis
+    assert pruned_design(target, source, SimpleNamespace(raw=SimpleNamespace(q_d=q_d, Q=Q))) is not None
+    Q[:, 0] = -2.5  # the workpiece 2.5 m above the shorter arm's base: beyond placement.z's upper bound of 2 m
+    assert pruned_design(target, source, SimpleNamespace(raw=SimpleNamespace(q_d=q_d, Q=Q))) is None
+
+
+@pytest.mark.parametrize("still", [True, False])
+def test_a_structure_is_pruned_from_a_longer_one_only_when_its_first_joint_stays_still(still):
+    from types import SimpleNamespace
+
+    from designopt.solve import Job, Searched, preset
+    from designopt.solve.starts import Pruned
+    from designopt.solve.strategies import neighbours as neighbour_stage
+
+    def searched(structure, cost):
+        job = Job("sweep", _structure_problem(structure))
+        Q = np.linspace(0.0, 1.0, 6)[:, None] * np.ones(len(structure))
+        if still:
+            Q[:, 0] = 0.1
+        sol = SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
+                              raw=SimpleNamespace(q_d=job.problem.chain.design_values, objective=1.5 * cost, Q=Q))
+        return Searched(job, [], [(SimpleNamespace(), sol)])
+
+    tasks = next(neighbour_stage.plan([searched("RRP", 3.0), searched("RRRP", 2.0)], preset("quick")), [])
+    pruned = [t for t in tasks if isinstance(t.start, Pruned)]
+    assert len(pruned) == still and all(t.problem.chain.structure == "RRP" and t.profile.warm for t in pruned)
+    assert len({t.start.number for t in tasks}) == len(tasks)
 
 
 def test_a_neighbours_design_starts_the_joints_of_the_same_name():

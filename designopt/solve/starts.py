@@ -1,6 +1,7 @@
 """Where a solve starts: a seeded start (`Seeded`), a solution of another sampling of the same task (`Lifted`), a
 coarse optimum's design on a new joint branch (`Rebranched`), a solution of a structure with one joint fewer
-(`Grown`), or a solution written with one length's sign flipped and pushed across its bound (`Reflected`).
+(`Grown`) or with one still joint more (`Pruned`), or a solution written with one length's sign flipped and pushed
+across its bound (`Reflected`).
 
 Every start has a ``number`` that identifies it in a run's files (the seed column of summary.csv):
 `initial_guess.start_number` (seed * 1000 + index) for a seeded, rebranched or grown start, the lifted solution's
@@ -14,7 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from designopt.initial_guess import design_named, initial_guess, projected, start_number
+from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.reflections import Reflection
+from designopt.kinematics.transforms import dh_transform, inverse
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
@@ -149,6 +152,60 @@ def grown_guess(problem: DesignProblem, source: DesignProblem, solution, where: 
     Q = np.insert(solution.sample(t), where, 0.0, axis=1)
     V = np.insert(solution.sample_velocity(t), where, 0.0, axis=1)
     return InitialGuess(q_d=design_named(problem, given), Q=Q, V=V, seed=seed)
+
+
+@dataclass(frozen=True, eq=False)
+class Pruned:
+    """A solution of a structure with one joint more (``source``, its problem) whose first joint stays still along
+    the path, as a start of this structure, which is that one without its first link (`pruned_guess`): the same arm
+    and motion, the still link's transform carried into the placement. The start tracks the path as the solution
+    did. ``seed`` and ``index`` number it."""
+
+    solution: object  # designopt.solution.Solution
+    source: DesignProblem
+    seed: int
+    index: int
+
+    @property
+    def number(self) -> int:
+        return start_number(self.seed, self.index)
+
+    def guess(self, problem: DesignProblem) -> InitialGuess:
+        q_d = pruned_design(problem, self.source, self.solution)
+        t = problem.toolpath.t
+        Q = np.delete(self.solution.sample(t), 0, axis=1)
+        V = np.delete(self.solution.sample_velocity(t), 0, axis=1)
+        return InitialGuess(q_d=q_d, Q=projected(problem, q_d, Q), V=V, seed=self.number)
+
+
+def pruned_design(problem: DesignProblem, source: DesignProblem, solution) -> np.ndarray | None:
+    """`Pruned`'s design: ``source``'s chain is ``problem``'s with a DH link inserted first (both DH tables), and
+    its first joint is held at its mean over ``solution``'s knots. Link i + 1 of ``source`` becomes link i, its
+    design joints carried by parameter; the placement T_BW (workpiece in base, m and rad) becomes inv(T_1) T_BW,
+    T_1 the held first link's transform, written as x, y, z and yaw, pitch, roll (Rz Ry Rx). None when that
+    placement leaves its bounds, or when ``problem``'s placement is not those six design joints."""
+    short, long_ = problem.chain, source.chain
+    if short.dh is None or long_.dh is None or long_.structure[1:] != short.structure:
+        raise ValueError(f"{short.structure} is not {long_.structure} without its first joint")
+    names = [j.name for j in short.placement_joints]
+    if names != [f"placement.{k}" for k in ("x", "y", "z", "yaw", "pitch", "roll")] or not all(
+            j.role.name == "DESIGN" for j in short.placement_joints):
+        return None
+    q_d = np.asarray(solution.raw.q_d, float)
+    q_m = np.mean(np.asarray(solution.raw.Q, float), axis=0)
+    values = long_.values(q_m, q_d)
+    first = dh_transform(*(float(values[k]) for k in long_.dh[0]))
+    place = inverse(first) @ np.asarray(placement_pose(long_, q_m, q_d), float)
+    R = place[:3, :3]
+    pose = {"x": place[0, 3], "y": place[1, 3], "z": place[2, 3], "yaw": np.arctan2(R[1, 0], R[0, 0]),
+            "pitch": np.arctan2(-R[2, 0], np.hypot(R[0, 0], R[1, 0])), "roll": np.arctan2(R[2, 1], R[2, 2])}
+    given = {f"placement.{k}": float(v) for k, v in pose.items()}
+    if any(not j.lower <= given[j.name] <= j.upper for j in short.placement_joints):
+        return None
+    for i, link in enumerate(short.dh):
+        moved = long_.dh[i + 1]
+        given |= {short.joints[b].name: float(values[a]) for a, b in zip(moved, link, strict=True)}
+    return design_named(problem, given)
 
 
 def lifted_guess(problem: DesignProblem, solution) -> InitialGuess:

@@ -5,7 +5,9 @@ one joint's type differs (R <-> P), or one has a joint the other lacks. A struct
 design was stuck in a worse basin, and the neighbour's design is a good guess for it: a structure of the same
 length starts from its placement and every link parameter of the same name (`Seeded` with that design, joints by
 IK); a structure with one joint fewer is this one with a link held as an identity transform, so its solution, the
-link inserted, is a start that already tracks the path (`Grown`, solved warm). The starts are solved on the full
+link inserted, is a start that already tracks the path (`Grown`, solved warm); and a structure with one joint more
+inserted first whose first joint stays still along the path is this one placed by that link's transform, so its
+solution without the link is an exact start too (`Pruned`, solved warm). The starts are solved on the full
 path (stage ``neighbour``) and join each problem's final solves; one that is still above ``BOUND_FACTOR`` times its
 structure's best objective after ``BOUND_AFTER`` iterations is stopped there (`designopt.solve.observers.AboveBound`).
 Problems without neighbours (every search of a single structure) get no task.
@@ -13,10 +15,12 @@ Problems without neighbours (every search of a single structure) get no task.
 
 from __future__ import annotations
 
+import numpy as np
+
 from designopt.initial_guess import design_from
 from designopt.solve.observers import Bound
 from designopt.solve.search import Searched, by_job
-from designopt.solve.starts import Grown, Seeded
+from designopt.solve.starts import Grown, Pruned, Seeded, pruned_design
 from designopt.solve.strategies.steps import solve_setup
 from designopt.solve.tasks import Task
 
@@ -27,6 +31,10 @@ STAGE = "neighbour"
 # were above 3x; on an untouched seed 4 of the 119 it stopped would have beaten it, where other starts reached or
 # beat those bests (docs/decisions.md).
 BOUND_FACTOR, BOUND_AFTER = 3.0, 300
+# A longer structure's first joint that moves less than STILL (rad or m) along the path makes its arm the shorter
+# structure's (`Pruned`); pruned starts are numbered from PRUNED_FROM (after same-length and grown ones)
+STILL = 1e-3
+PRUNED_FROM = 50
 
 
 def neighbours(structure: str, structures: list[str]) -> list[str]:
@@ -41,6 +49,18 @@ def shorter(structure: str, structures: list[str]) -> list[tuple[str, int]]:
     can be one shorter one in several ways (RRPR: RPR without joint 0 or 1)."""
     present = set(structures)
     return [(other, k) for k in range(len(structure)) if (other := structure[:k] + structure[k + 1:]) in present]
+
+
+def longer(structure: str, structures: list[str]) -> list[str]:
+    """The structures among ``structures`` that are ``structure`` with one joint inserted first."""
+    return [s for s in structures if len(s) == len(structure) + 1 and s[1:] == structure]
+
+
+def still_first(solution) -> bool:
+    """Whether a solution's first joint moves less than ``STILL`` (rad or m) along the path: its arm is then the
+    shorter structure's, placed elsewhere (`starts.Pruned`)."""
+    first = np.asarray(solution.raw.Q, float)[:, 0]
+    return bool(np.ptp(first) < STILL)
 
 
 def plan(searched, search):
@@ -68,6 +88,11 @@ def plan(searched, search):
             if found := cheaper(job.case, other, own):
                 starts.append((solve_setup(job, search, search.profile.warmed()),
                                Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)))
+        for k, other in enumerate(longer(structure, same_case)):
+            if (found := cheaper(job.case, other, own)) and still_first(found[1]) and pruned_design(
+                    job.problem, found[0].problem, found[1]) is not None:
+                starts.append((solve_setup(job, search, search.profile.warmed()),
+                               Pruned(found[1], found[0].problem, search.seed, PRUNED_FROM + k)))
         bound = Bound(BOUND_FACTOR * own.raw.objective, BOUND_AFTER) if own is not None else None
         tasks += [Task(job.case, STAGE, job.problem, job.transcription, profile.observing("above_bound"), start,
                        continuation, bound) for (profile, continuation), start in starts]
