@@ -196,6 +196,35 @@ def test_a_structure_is_pruned_from_a_longer_one_only_when_its_first_joint_stays
     assert len({t.start.number for t in tasks}) == len(tasks)
 
 
+def test_a_second_pass_starts_only_from_the_structures_the_first_pass_lowered():
+    """RRP (3.0) is cheaper than its neighbours RRR (4.0) and RPP (5.0): the first pass gives each of them a start from
+    it. RRR's start lands at 1.0, RPP's at 6.0: the second pass (``neighbour2``) gives RRP a start from RRR, the one
+    structure the first pass lowered, and nothing else (RPP is not RRR's neighbour); then the step ends."""
+    from types import SimpleNamespace
+
+    from designopt.solve import Job, Searched, preset
+    from designopt.solve.strategies import neighbours as neighbour_stage
+
+    def solution(structure, cost):
+        Q = np.linspace(0.0, 1.0, 6)[:, None] * np.ones(len(structure))
+        return SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
+                               raw=SimpleNamespace(q_d=_structure_problem(structure).chain.design_values,
+                                                   objective=1.5 * cost, Q=Q))
+
+    searched = [Searched(Job("sweep", _structure_problem(s)), [], [(SimpleNamespace(), solution(s, c))])
+                for s, c in (("RRP", 3.0), ("RRR", 4.0), ("RPP", 5.0))]
+    plan = neighbour_stage.plan(searched, preset("quick"))
+    first = next(plan)
+    assert sorted((t.problem.chain.structure, t.stage) for t in first) == [("RPP", "neighbour"), ("RRR", "neighbour")]
+    landed = {"RRR": 1.0, "RPP": 6.0}
+    second = plan.send([(t, solution(t.problem.chain.structure, landed[t.problem.chain.structure])) for t in first])
+    assert [(t.problem.chain.structure, t.stage) for t in second] == [("RRP", "neighbour2")]
+    with pytest.raises(StopIteration) as done:
+        plan.send([(second[0], solution("RRP", 0.5))])
+    bests = {s.job.problem.chain.structure: s.best[1].metrics.design_cost for s in done.value.value}
+    assert bests == {"RRP": 0.5, "RRR": 1.0, "RPP": 5.0}
+
+
 def test_a_neighbours_design_starts_the_joints_of_the_same_name():
     from designopt.config import parse_config
     from designopt.initial_guess import design_from

@@ -35,6 +35,8 @@ BOUND_FACTOR, BOUND_AFTER = 3.0, 300
 # structure's (`Pruned`); pruned starts are numbered from PRUNED_FROM (after same-length and grown ones)
 STILL = 1e-3
 PRUNED_FROM = 50
+# Passes of the step: a later pass gives starts only from the neighbours whose best the pass before lowered
+PASSES = 2
 
 
 def neighbours(structure: str, structures: list[str]) -> list[str]:
@@ -64,12 +66,33 @@ def still_first(solution) -> bool:
 
 
 def plan(searched, search):
+    """Up to ``PASSES`` passes (stages ``neighbour``, ``neighbour2``, ...): the first gives each structure a start from
+    every neighbour that found a cheaper design; each later one only from the neighbours whose best the pass before
+    lowered, so that a design found in a pass reaches the structures next to it."""
     jobs = [s.job for s in searched]
+    lowered = None  # (case, structure) whose best the last pass lowered; None before the first pass: all
+    for i in range(PASSES):
+        tasks = _starts(searched, search, STAGE if i == 0 else f"{STAGE}{i + 1}", lowered)
+        if not tasks:
+            break
+        more = by_job(jobs, (yield tasks))
+        after = [Searched(s.job, s.explore, s.final + m) for s, m in zip(searched, more, strict=True)]
+        lowered = {(a.job.case, a.job.problem.chain.structure) for s, a in zip(searched, after, strict=True)
+                   if a.best[1] is not None and a.best[1] is not s.best[1]}
+        searched = after
+    return searched
+
+
+def _starts(searched, search, stage: str, lowered) -> list[Task]:
+    """One pass's tasks: for every structure, a start from each neighbour (among ``lowered``, when given) that found
+    a cheaper design."""
     best = {(s.job.case, s.job.problem.chain.structure): (s.job, s.best[1]) for s in searched}
 
     def cheaper(case: str, other: str, own) -> tuple | None:
         """(job, best solution) of structure ``other`` when it found a cheaper design than ``own``."""
         other_job, theirs = best[case, other]
+        if lowered is not None and (case, other) not in lowered:
+            return None
         if theirs is None or (own is not None and theirs.metrics.design_cost >= own.metrics.design_cost):
             return None
         return other_job, theirs
@@ -94,9 +117,6 @@ def plan(searched, search):
                 starts.append((solve_setup(job, search, search.profile.warmed()),
                                Pruned(found[1], found[0].problem, search.seed, PRUNED_FROM + k)))
         bound = Bound(BOUND_FACTOR * own.raw.objective, BOUND_AFTER) if own is not None else None
-        tasks += [Task(job.case, STAGE, job.problem, job.transcription, profile.observing("above_bound"), start,
+        tasks += [Task(job.case, stage, job.problem, job.transcription, profile.observing("above_bound"), start,
                        continuation, bound) for (profile, continuation), start in starts]
-    if not tasks:
-        return searched
-    more = by_job(jobs, (yield tasks))
-    return [Searched(s.job, s.explore, s.final + m) for s, m in zip(searched, more, strict=True)]
+    return tasks
