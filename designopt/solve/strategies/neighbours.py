@@ -8,7 +8,9 @@ IK); a structure with one joint fewer is this one with a link held as an identit
 link inserted, is a start that already tracks the path (`Grown`, solved warm); and a structure with one joint more
 inserted first whose first joint stays still along the path is this one placed by that link's transform, so its
 solution without the link is an exact start too (`Pruned`, solved warm). The starts are solved on the full
-path (stage ``neighbour``) and join each problem's final solves; one that is still above ``BOUND_FACTOR`` times its
+path (stage ``neighbour``) and join each problem's final solves; a second pass (``neighbour2``) gives starts from the
+structures whose best the first lowered, so that a design found there reaches the structures next to it (up to
+``PASSES`` passes). A start that is still above ``BOUND_FACTOR`` times its
 structure's best objective after ``BOUND_AFTER`` iterations is stopped there (`designopt.solve.observers.AboveBound`).
 Problems without neighbours (every search of a single structure) get no task.
 """
@@ -35,7 +37,10 @@ BOUND_FACTOR, BOUND_AFTER = 3.0, 300
 # structure's (`Pruned`); pruned starts are numbered from PRUNED_FROM (after same-length and grown ones)
 STILL = 1e-3
 PRUNED_FROM = 50
-# Passes of the step: a later pass gives starts only from the neighbours whose best the pass before lowered
+# Passes of the step: a later pass gives starts only from the neighbours whose best the pass before lowered. A second
+# pass on the K = I sweep's seeds 2101-2104: 52-75 more solves (2-8 % of the solver time), 9 structure bests lower by
+# more than 1 % (RRR reaching its reference through PRRR's pruned design; PPRPRR 0.45x), none higher
+# (docs/benchmarks.md, "Sweep")
 PASSES = 2
 
 
