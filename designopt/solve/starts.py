@@ -16,6 +16,7 @@ import numpy as np
 
 from designopt.initial_guess import design_named, initial_guess, projected, start_number
 from designopt.kinematics.chain import placement_pose
+from designopt.kinematics.joints import Role
 from designopt.kinematics.reflections import Reflection
 from designopt.kinematics.transforms import dh_transform, inverse
 from designopt.problem import DesignProblem
@@ -189,13 +190,12 @@ def pruned_design(problem: DesignProblem, source: DesignProblem, solution) -> np
         raise ValueError(f"{short.structure} is not {long_.structure} without its first joint")
     names = [j.name for j in short.placement_joints]
     if names != [f"placement.{k}" for k in ("x", "y", "z", "yaw", "pitch", "roll")] or not all(
-            j.role.name == "DESIGN" for j in short.placement_joints):
+            j.role is Role.DESIGN for j in short.placement_joints):
         return None
-    q_d = np.asarray(solution.raw.q_d, float)
-    q_m = np.mean(np.asarray(solution.raw.Q, float), axis=0)
-    values = long_.values(q_m, q_d)
+    q_long, q_m = np.asarray(solution.raw.q_d, float), np.mean(np.asarray(solution.raw.Q, float), axis=0)
+    values = long_.values(q_m, q_long)
     first = dh_transform(*(float(values[k]) for k in long_.dh[0]))
-    place = inverse(first) @ np.asarray(placement_pose(long_, q_m, q_d), float)
+    place = inverse(first) @ np.asarray(placement_pose(long_, q_m, q_long), float)
     R = place[:3, :3]
     pose = {"x": place[0, 3], "y": place[1, 3], "z": place[2, 3], "yaw": np.arctan2(R[1, 0], R[0, 0]),
             "pitch": np.arctan2(-R[2, 0], np.hypot(R[0, 0], R[1, 0])), "roll": np.arctan2(R[2, 1], R[2, 2])}
