@@ -4,8 +4,8 @@ coarse optimum's design on a new joint branch (`Rebranched`), a solution of a st
 across its bound (`Reflected`).
 
 Every start has a ``number`` that identifies it in a run's files (the seed column of summary.csv):
-`initial_guess.start_number` (seed * 1000 + index) for a seeded, rebranched or grown start, the lifted solution's
-number for a lifted one.
+`initial_guess.start_number` (seed * 1000 + index) for a seeded, rebranched, reflected, grown or pruned start
+(`Numbered`), the lifted solution's number for a lifted one.
 """
 
 from __future__ import annotations
@@ -19,12 +19,21 @@ from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.joints import Role
 from designopt.kinematics.reflections import Reflection
 from designopt.kinematics.transforms import dh_transform, inverse
+from designopt.kinematics.urdf import rpy_of
 from designopt.problem import DesignProblem
 from designopt.transcriptions.base import InitialGuess
 
 
+class Numbered:
+    """A start numbered by its ``seed`` and ``index`` fields: ``number`` is `initial_guess.start_number` of them."""
+
+    @property
+    def number(self) -> int:
+        return start_number(self.seed, self.index)
+
+
 @dataclass(frozen=True, eq=False)
-class Seeded:
+class Seeded(Numbered):
     """Start ``index`` of a seeded multistart (`designopt.initial_guess`): index 0 keeps the configured design, the
     others perturb it by ``scale`` (x 0.5 m for lengths, x pi for angles) or draw it from the task's box (``spread``
     box; mixed: odd starts from the box, even ones perturbed), or ``design`` is the start design;
@@ -36,10 +45,6 @@ class Seeded:
     init: str = "ik"
     design: np.ndarray | None = None
     spread: str = "perturb"
-
-    @property
-    def number(self) -> int:
-        return start_number(self.seed, self.index)
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
         return initial_guess(problem, self.index, self.seed, self.scale, self.init, self.design, self.spread)
@@ -61,7 +66,7 @@ class Lifted:
 
 
 @dataclass(frozen=True, eq=False)
-class Rebranched:
+class Rebranched(Numbered):
     """A coarse optimum started again on a new joint branch: its design joints, and start ``index`` of ``seed``'s
     first configuration drawn over the whole circle (revolute joints in [-pi, pi] rad), walked along the path by
     IK (``init``). A design's best basin is often on a branch its own start never visits (a folded posture, the
@@ -72,10 +77,6 @@ class Rebranched:
     index: int
     init: str = "ik"
 
-    @property
-    def number(self) -> int:
-        return start_number(self.seed, self.index)
-
     def guess(self, problem: DesignProblem) -> InitialGuess:
         # with a design given, spread "box" only sets the first joints' range: the whole circle
         return initial_guess(problem, self.index, self.seed, 0.0, self.init, np.asarray(self.solution.raw.q_d, float),
@@ -83,7 +84,7 @@ class Rebranched:
 
 
 @dataclass(frozen=True, eq=False)
-class Reflected:
+class Reflected(Numbered):
     """A full-path solution reflected across a length bound (`designopt.kinematics.reflections`): the same arm and
     motion written with that length's sign flipped, then the length pushed ``step`` (m) past its bound of 0 -- the
     side the bound had closed -- and each waypoint moved onto the path with that design (`projected`). ``seed`` and
@@ -95,10 +96,6 @@ class Reflected:
     seed: int
     index: int
 
-    @property
-    def number(self) -> int:
-        return start_number(self.seed, self.index)
-
     def guess(self, problem: DesignProblem) -> InitialGuess:
         chain, t = problem.chain, problem.toolpath.t
         q_d, k = self.reflection.design(chain, self.solution.raw.q_d), self.reflection.length(chain)
@@ -109,7 +106,7 @@ class Reflected:
 
 
 @dataclass(frozen=True, eq=False)
-class Grown:
+class Grown(Numbered):
     """A solution of a structure with one joint fewer (``source``, its problem) as a start of this structure, which
     is that one with a link inserted at ``where`` (0-based): the link an identity transform (its DH parameters 0)
     whose joint stays at 0 along the path, every other design joint and joint trajectory the solution's
@@ -121,10 +118,6 @@ class Grown:
     where: int
     seed: int
     index: int
-
-    @property
-    def number(self) -> int:
-        return start_number(self.seed, self.index)
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
         return grown_guess(problem, self.source, self.solution, self.where, self.number)
@@ -156,27 +149,22 @@ def grown_guess(problem: DesignProblem, source: DesignProblem, solution, where: 
 
 
 @dataclass(frozen=True, eq=False)
-class Pruned:
-    """A solution of a structure with one joint more (``source``, its problem) whose first joint stays still along
-    the path, as a start of this structure, which is that one without its first link (`pruned_guess`): the same arm
-    and motion, the still link's transform carried into the placement. The start tracks the path as the solution
-    did. ``seed`` and ``index`` number it."""
+class Pruned(Numbered):
+    """A solution of a structure with one joint more whose first joint stays still along the path, as a start of
+    this structure, which is that one without its first link: ``design`` (`pruned_design`: the same arm, the still
+    link's transform carried into the placement) and the solution's motion without the first joint. The start
+    tracks the path as the solution did. ``seed`` and ``index`` number it."""
 
     solution: object  # designopt.solution.Solution
-    source: DesignProblem
+    design: np.ndarray
     seed: int
     index: int
 
-    @property
-    def number(self) -> int:
-        return start_number(self.seed, self.index)
-
     def guess(self, problem: DesignProblem) -> InitialGuess:
-        q_d = pruned_design(problem, self.source, self.solution)
         t = problem.toolpath.t
         Q = np.delete(self.solution.sample(t), 0, axis=1)
         V = np.delete(self.solution.sample_velocity(t), 0, axis=1)
-        return InitialGuess(q_d=q_d, Q=projected(problem, q_d, Q), V=V, seed=self.number)
+        return InitialGuess(q_d=self.design, Q=projected(problem, self.design, Q), V=V, seed=self.number)
 
 
 def pruned_design(problem: DesignProblem, source: DesignProblem, solution) -> np.ndarray | None:
@@ -196,9 +184,8 @@ def pruned_design(problem: DesignProblem, source: DesignProblem, solution) -> np
     values = long_.values(q_m, q_long)
     first = dh_transform(*(float(values[k]) for k in long_.dh[0]))
     place = inverse(first) @ np.asarray(placement_pose(long_, q_m, q_long), float)
-    R = place[:3, :3]
-    pose = {"x": place[0, 3], "y": place[1, 3], "z": place[2, 3], "yaw": np.arctan2(R[1, 0], R[0, 0]),
-            "pitch": np.arctan2(-R[2, 0], np.hypot(R[0, 0], R[1, 0])), "roll": np.arctan2(R[2, 1], R[2, 2])}
+    roll, pitch, yaw = rpy_of(place[:3, :3])
+    pose = {"x": place[0, 3], "y": place[1, 3], "z": place[2, 3], "yaw": yaw, "pitch": pitch, "roll": roll}
     given = {f"placement.{k}": float(v) for k, v in pose.items()}
     if any(not j.lower <= given[j.name] <= j.upper for j in short.placement_joints):
         return None

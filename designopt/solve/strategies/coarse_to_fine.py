@@ -30,7 +30,7 @@ from designopt.problem import DesignProblem
 from designopt.solve.optima import best_solution, distinct_best
 from designopt.solve.search import Searched, by_job
 from designopt.solve.starts import Lifted, Rebranched
-from designopt.solve.strategies.steps import seeded_tasks, solve_setup
+from designopt.solve.strategies.steps import numbered_stage, seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
 
@@ -56,12 +56,6 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
         for i in distinct_best([sol for _, sol in done], count, search.distinct, per_form):
             tasks.append(Task(job.case, stage, problem, job.transcription, profile, Lifted(done[i][1]), continuation))
     return tasks
-
-
-def numbered_stage(stage: str, i: int) -> str:
-    """The name of a stage's pass from a search's ``i``-th barrier (`Search.screen_mu_init`,
-    `Search.refine_mu_init`): screen, screen2, ...; refine, refine2, ..."""
-    return stage if i == 0 else f"{stage}{i + 1}"
 
 
 def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:

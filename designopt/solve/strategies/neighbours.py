@@ -23,7 +23,7 @@ from designopt.initial_guess import design_from
 from designopt.solve.observers import Bound
 from designopt.solve.search import Searched, by_job
 from designopt.solve.starts import Grown, Pruned, Seeded, pruned_design
-from designopt.solve.strategies.steps import solve_setup
+from designopt.solve.strategies.steps import numbered_stage, solve_setup
 from designopt.solve.tasks import Task
 
 STAGE = "neighbour"
@@ -77,7 +77,7 @@ def plan(searched, search):
     jobs = [s.job for s in searched]
     lowered = None  # (case, structure) whose best the last pass lowered; None before the first pass: all
     for i in range(PASSES):
-        tasks = _starts(searched, search, STAGE if i == 0 else f"{STAGE}{i + 1}", lowered)
+        tasks = _starts(searched, search, numbered_stage(STAGE, i), lowered)
         if not tasks:
             break
         more = by_job(jobs, (yield tasks))
@@ -117,10 +117,11 @@ def _starts(searched, search, stage: str, lowered) -> list[Task]:
                 starts.append((solve_setup(job, search, search.profile.warmed()),
                                Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)))
         for k, other in enumerate(longer(structure, same_case)):
-            if (found := cheaper(job.case, other, own)) and still_first(found[1]) and pruned_design(
-                    job.problem, found[0].problem, found[1]) is not None:
+            if not (found := cheaper(job.case, other, own)) or not still_first(found[1]):
+                continue
+            if (design := pruned_design(job.problem, found[0].problem, found[1])) is not None:
                 starts.append((solve_setup(job, search, search.profile.warmed()),
-                               Pruned(found[1], found[0].problem, search.seed, PRUNED_FROM + k)))
+                               Pruned(found[1], design, search.seed, PRUNED_FROM + k)))
         bound = Bound(BOUND_FACTOR * own.raw.objective, BOUND_AFTER) if own is not None else None
         tasks += [Task(job.case, stage, job.problem, job.transcription, profile.observing("above_bound"), start,
                        continuation, bound) for (profile, continuation), start in starts]

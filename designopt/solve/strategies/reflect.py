@@ -17,7 +17,7 @@ from designopt.kinematics.reflections import at_bound
 from designopt.solve.optima import best_solution
 from designopt.solve.search import Searched, by_job
 from designopt.solve.starts import Reflected
-from designopt.solve.strategies.steps import solve_setup
+from designopt.solve.strategies.steps import numbered_stage, solve_setup
 from designopt.solve.tasks import Task
 
 STAGE = "reflect"
@@ -33,11 +33,6 @@ GAIN = 1e-3
 FIRST_START = 900  # the first start index of a reflect stage's starts, after any exploration's
 
 
-def stage(i: int) -> str:
-    """The ``i``-th round's stage (0-based): reflect, reflect2, ..."""
-    return STAGE if i == 0 else f"{STAGE}{i + 1}"
-
-
 def plan(searched: list[Searched], search):
     """Up to ``search.reflect`` rounds over every problem's best full-path solution (a generator, as a strategy's
     plan: yields a round's tasks, receives their solutions); returns ``searched`` with the rounds' solves added to
@@ -48,7 +43,7 @@ def plan(searched: list[Searched], search):
     for i in range(search.reflect):
         bests = [best_solution([sol for _, sol in done]) for done in final]
         tasks = reflected_tasks([(job, best) for job, best, last in zip(jobs, bests, looked_at, strict=True)
-                                 if best is not None and best is not last], stage(i), search)
+                                 if best is not None and best is not last], numbered_stage(STAGE, i), search)
         if not tasks:
             break
         more = by_job(jobs, (yield tasks))

@@ -1,4 +1,5 @@
-"""What every strategy's tasks share: the profile and continuation of a job's solves, and seeded starts."""
+"""What every strategy's tasks share: the profile and continuation of a job's solves, seeded starts, and the names
+of a stage's passes."""
 
 from __future__ import annotations
 
@@ -24,3 +25,9 @@ def seeded_tasks(job: Job, stage: str, problem, profile, search: Search, count: 
     return [Task(job.case, stage, problem, job.transcription, profile,
                  Seeded(search.seed, i, search.perturbation, search.init, spread=search.spread), continuation)
             for i in range(count)]
+
+
+def numbered_stage(stage: str, i: int) -> str:
+    """The name of a stage's ``i``-th pass (0-based): screen, screen2, ... (one per barrier of `Search.screen_mu_init`
+    or `Search.refine_mu_init`); reflect, reflect2, ... (rounds); neighbour, neighbour2, ... (passes)."""
+    return stage if i == 0 else f"{stage}{i + 1}"
