@@ -27,8 +27,8 @@ class Ma27:
     triplets ``rows``, ``cols``, 0-based), then factorise and solve as often as wanted. INFO is MA27's: INFO(1)
     (``info[0]``) 0 on success, -5 for a singular matrix; INFO(15) (``info[14]``) the negative eigenvalues."""
 
-    def __init__(self, n: int, rows, cols):
-        self.lib = ctypes.CDLL(str(library()))
+    def __init__(self, n: int, rows, cols, path=None):
+        self.lib = ctypes.CDLL(str(path or library()))  # ``path``: another copy of the library, loaded apart
         self.n, self.nz = n, len(rows)
         self.irn = np.ascontiguousarray(np.asarray(rows) + 1, dtype=np.int32)
         self.icn = np.ascontiguousarray(np.asarray(cols) + 1, dtype=np.int32)

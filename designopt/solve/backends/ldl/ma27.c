@@ -9,14 +9,20 @@
  * Where MA27 keeps things, this keeps them too, so that nothing is allocated between calls and nothing leaks when
  * IPOPT drops a solver: the ordering in IKEEP (3n ints, from ma27ad on), the factors in A (doubles) and IW (ints),
  * whose sizes ma27ad asks for through INFO(5) and INFO(6). Layouts:
- *   IKEEP: P[n] (new -> old), Pinv[n] (old -> new), nnzA, nnzL, generation (a number per analysis, n > 2)
+ *   IKEEP: P[n] (new -> old), Pinv[n] (old -> new), then (n >= RECORD) nnzA, nnzL, whether reordered, and the
+ *          workspace the pattern was built in: IW's address (two ints) and LIW
  *   IW: header[HDR] | Ap[n+1] Ai[nnzA] (the permuted upper triangle, every diagonal present) | Lp[n+1] Li[nnzL] |
  *       etree[n] Lnz[n] | iwork[3n] (QDLDL's; after a factorisation its first n hold P for ma27cd) |
  *       bwork[n] (QDLDL's; after a factorisation bwork[0] holds the offset of Lx in A) | map[nz] (triplet ->
  *       Ai slot) | scratch for building the pattern [2 nz + 2 n]
  *   A: the triplets' values[nz] (written by IPOPT) | Ax[nnzA] | Lx[nnzL] | D[n] | Dinv[n] | fwork[n] | x[n]
- * The pattern of IW is built at the first factorisation of an analysis and reused by the next ones (header:
- * MAGIC, n, nz, generation, nnzL, LIW), so a factorisation is a scatter of the values and QDLDL's numeric pass.
+ * The pattern of IW is built at the first factorisation of an analysis and reused by the next ones, so a
+ * factorisation is a scatter of the values and QDLDL's numeric pass. Whether IW holds this analysis's pattern is
+ * recorded in IKEEP (IW's address and LIW when it was built), never read from IW itself: IPOPT allocates IW
+ * anew for each analysis and does not clear it, so it may hold what an earlier analysis left there (a header that
+ * matched and a stale map once scattered out of bounds: a screen solve's segfault, docs/decisions.md). IW's header
+ * (n, nz, nnzA, nnzL) is for ma27cd, which is given IW but not IKEEP. Systems with n < RECORD are analysed anew
+ * at every factorisation.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -26,7 +32,7 @@
 #include "qdldl.h"
 
 #define HDR 8
-#define MAGIC 0x4d413237
+#define RECORD 6 /* IKEEP's entries after P and Pinv that this uses: n >= RECORD keeps them */
 #define WEAK 1e-7 /* a diagonal entry this small counts as zero for the ordering (IPOPT's delta_c <= 1e-8) */
 
 static int ints_needed(int n, int nz, int nnzA, int nnzL) {
@@ -159,6 +165,21 @@ static int factor_sizes(int n, int nz, const int *IRN, const int *ICN, const int
     return *nnzL < 0 ? -1 : 0;
 }
 
+/* An analysis's record (IKEEP after P and Pinv) of the workspace its pattern was built in: IW's address, split in
+ * two ints, and LIW (NULL, 0: none). Within one analysis IPOPT only ever replaces IW by a larger one. */
+static void record_workspace(int *record, const int *IW, int LIW) {
+    unsigned long long address = (unsigned long long)(size_t)IW;
+    record[3] = (int)(unsigned)(address & 0xffffffffu);
+    record[4] = (int)(unsigned)(address >> 32);
+    record[5] = LIW;
+}
+
+static int built_in(const int *record, const int *IW, int LIW) {
+    unsigned long long address = (unsigned long long)(size_t)IW;
+    return IW != NULL && record[5] == LIW && record[3] == (int)(unsigned)(address & 0xffffffffu) &&
+           record[4] == (int)(unsigned)(address >> 32);
+}
+
 static void ma27i(int *ICNTL, double *CNTL) {
     memset(ICNTL, 0, 30 * sizeof(int));
     memset(CNTL, 0, 5 * sizeof(double));
@@ -166,7 +187,6 @@ static void ma27i(int *ICNTL, double *CNTL) {
 }
 
 static void ma27a(int *N, int *NZ, const int *IRN, const int *ICN, int *IKEEP, int *NSTEPS, int *INFO, double *OPS) {
-    static int generations = 0;
     int n = *N, nz = *NZ, j, status, nnzA, nnzL;
     double control[AMD_CONTROL], info[AMD_INFO];
     int *P = IKEEP, *Pinv = IKEEP + n;
@@ -184,10 +204,12 @@ static void ma27a(int *N, int *NZ, const int *IRN, const int *ICN, int *IKEEP, i
     for (j = 0; j < n; j++) Pinv[P[j]] = j;
     /* the sizes of the factors, for the workspace IPOPT allocates (ma27b may reorder and ask for more) */
     if (factor_sizes(n, nz, IRN, ICN, Pinv, &nnzA, &nnzL) < 0) { INFO[0] = -1; return; }
-    IKEEP[2 * n] = nnzA;
-    if (n > 1) IKEEP[2 * n + 1] = nnzL;
-    if (n > 2) IKEEP[2 * n + 2] = (++generations & 0x3fffffff) + 1;
-    if (n > 3) IKEEP[2 * n + 3] = 0; /* not yet reordered for the first matrix's zero diagonal */
+    if (n >= RECORD) {
+        IKEEP[2 * n] = nnzA;
+        IKEEP[2 * n + 1] = nnzL;
+        IKEEP[2 * n + 2] = 0; /* not yet reordered for the first matrix's zero diagonal */
+        record_workspace(IKEEP + 2 * n, NULL, 0); /* no pattern built yet */
+    }
     *OPS = (double)nnzL;
     INFO[4] = doubles_needed(n, nz, nnzA, nnzL);
     INFO[5] = ints_needed(n, nz, nnzA, nnzL);
@@ -195,18 +217,25 @@ static void ma27a(int *N, int *NZ, const int *IRN, const int *ICN, int *IKEEP, i
 
 static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, int *LA, int *IW, int *LIW,
                   int *IKEEP, int *MAXFRT, int *INFO) {
-    int n = *N, nz = *NZ, k, pos;
+    int n = *N, nz = *NZ, k, pos, nnzA, nnzL;
+    int *record = n >= RECORD ? IKEEP + 2 * n : NULL;
     memset(INFO, 0, 20 * sizeof(int));
-    if (n > 3 && IKEEP[2 * n + 3] == 0) { /* the first matrix of this analysis: its zero diagonal decides */
-        int nnzA, nnzL;
+    if (record && record[2] == 0) { /* the first matrix of this analysis: its zero diagonal decides the order */
         if (defer_zero_pivots(n, nz, IRN, ICN, A, IKEEP, IKEEP + n) < 0 ||
             factor_sizes(n, nz, IRN, ICN, IKEEP + n, &nnzA, &nnzL) < 0) { INFO[0] = -1; return; }
-        IKEEP[2 * n] = nnzA;
-        IKEEP[2 * n + 1] = nnzL;
-        IKEEP[2 * n + 3] = 1;
+        record[0] = nnzA;
+        record[1] = nnzL;
+        record[2] = 1;
+        record_workspace(record, NULL, 0); /* the order changed: a pattern built before it is stale */
     }
     const int *Pinv = IKEEP + n;
-    int nnzA = IKEEP[2 * n], nnzL = n > 1 ? IKEEP[2 * n + 1] : 0, generation = n > 2 ? IKEEP[2 * n + 2] : -1;
+    if (record) {
+        nnzA = record[0];
+        nnzL = record[1];
+    } else if (factor_sizes(n, nz, IRN, ICN, Pinv, &nnzA, &nnzL) < 0) {
+        INFO[0] = -1;
+        return;
+    }
     int ineed = ints_needed(n, nz, nnzA, nnzL), dneed = doubles_needed(n, nz, nnzA, nnzL);
     *MAXFRT = 1;
     if (*LIW < ineed) { INFO[0] = -3; INFO[1] = ineed; return; }
@@ -214,13 +243,12 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
     int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
     int *Lnz = etree + n, *iwork = Lnz + n, *bwork = iwork + 3 * n, *map = bwork + n;
     int *scratch = map + nz; /* 2 nz + 2 n */
-    int cached = generation > 0 && IW[0] == MAGIC && IW[1] == n && IW[2] == nz && IW[3] == generation &&
-                 IW[4] == nnzA && IW[5] == nnzL && IW[6] == *LIW;
-    if (!cached) {
+    if (!(record && built_in(record, IW, *LIW))) {
         if (pattern(n, nz, IRN, ICN, Pinv, Ap, scratch, map) != nnzA) { INFO[0] = -1; return; }
         memcpy(Ai, scratch, sizeof(int) * nnzA);
         if (QDLDL_etree(n, Ap, Ai, iwork, Lnz, etree) != nnzL) { INFO[0] = -1; return; }
-        IW[0] = MAGIC; IW[1] = n; IW[2] = nz; IW[3] = generation; IW[4] = nnzA; IW[5] = nnzL; IW[6] = *LIW;
+        IW[0] = n; IW[1] = nz; IW[2] = nnzA; IW[3] = nnzL;
+        if (record) record_workspace(record, IW, *LIW);
     }
     double *Ax = A + nz, *Lx = Ax + nnzA, *D = Lx + nnzL, *Dinv = D + n, *fwork = Dinv + n;
     memset(Ax, 0, sizeof(double) * nnzA);
@@ -236,7 +264,7 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
 
 static void ma27c(int *N, double *A, int *IW, double *RHS) {
     int n = *N, i;
-    int nnzA = IW[4], nnzL = IW[5];
+    int nnzA = IW[2], nnzL = IW[3];
     int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
     int *Lnz = etree + n, *P = Lnz + n, *bwork = P + 3 * n;
     double *Lx = A + bwork[0], *Dinv = Lx + nnzL + n, *x = Dinv + 2 * n;
