@@ -226,7 +226,6 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
         record[0] = nnzA;
         record[1] = nnzL;
         record[2] = 1;
-        record_workspace(record, NULL, 0); /* the order changed: a pattern built before it is stale */
     }
     const int *Pinv = IKEEP + n;
     if (record) {
