@@ -292,7 +292,7 @@ MUTATIONS = [
              "for (k = 0; k < nz; k++) Ax[map[k]] = A[k];", ("tests/test_ldl.py",)),
     Mutation("the KKT solver trusts a workspace whose header is this size's (as before 2026-11-27)",
              "designopt/solve/backends/ldl/ma27.c", "if (!(record && built_in(record, IW, *LIW))) {",
-             "if (!(record && (IW[0] == n || built_in(record, IW, *LIW)))) {", ("tests/test_ldl.py",)),
+             "if (!(record && (IW[0] == nnzA || built_in(record, IW, *LIW)))) {", ("tests/test_ldl.py",)),
     Mutation("the exploration factorised by the profile's linear solver, not the search's",
              "designopt/solve/strategies/coarse_to_fine.py", ".solved_by(search.explore_linear_solver)", "",
              ("tests/test_search.py",)),

@@ -76,7 +76,7 @@ def test_a_new_analysis_builds_its_own_pattern_whatever_its_workspace_holds(tmp_
     """IPOPT allocates IW anew for each analysis and does not clear it, so a new analysis may be handed a block an
     earlier one filled (the allocator gives freed memory back), and a library loaded again counts from the start.
     Here the second analysis, in a second copy of the library, is handed the first one's workspace with everything
-    after its 8-int header zeroed: it must still factorise and solve its own matrix. Until 2026-11-27 the library
+    after its two-int header zeroed: it must still factorise and solve its own matrix. Until 2026-11-27 the library
     trusted a header that matched and scattered the values through the stale map: a screen solve's segfault."""
     rng = np.random.default_rng(5)
     K, rows, cols = random_kkt(rng, n_x=30, n_c=12, delta_c=1e-8, definite=True)
@@ -88,7 +88,7 @@ def test_a_new_analysis_builds_its_own_pattern_whatever_its_workspace_holds(tmp_
     second = Ma27(K.shape[0], rows, cols, path=copies[1])
     assert second.liw == first.liw
     second.iw = first.iw.copy()
-    second.iw[8:] = 0
+    second.iw[2:] = 0
     assert second.factorise(K[rows, cols])[0] == 0
     b = rng.normal(size=K.shape[0])
     np.testing.assert_allclose(second.solve(b), np.linalg.solve(K, b), rtol=1e-8, atol=1e-10)

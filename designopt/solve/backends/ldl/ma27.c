@@ -11,7 +11,7 @@
  * whose sizes ma27ad asks for through INFO(5) and INFO(6). Layouts:
  *   IKEEP: P[n] (new -> old), Pinv[n] (old -> new), then (n >= RECORD) nnzA, nnzL, whether reordered, and the
  *          workspace the pattern was built in: IW's address (two ints) and LIW
- *   IW: header[HDR] | Ap[n+1] Ai[nnzA] (the permuted upper triangle, every diagonal present) | Lp[n+1] Li[nnzL] |
+ *   IW: nnzA nnzL | Ap[n+1] Ai[nnzA] (the permuted upper triangle, every diagonal present) | Lp[n+1] Li[nnzL] |
  *       etree[n] Lnz[n] | iwork[3n] (QDLDL's; after a factorisation its first n hold P for ma27cd) |
  *       bwork[n] (QDLDL's; after a factorisation bwork[0] holds the offset of Lx in A) | map[nz] (triplet ->
  *       Ai slot) | scratch for building the pattern [2 nz + 2 n]
@@ -21,7 +21,7 @@
  * recorded in IKEEP (IW's address and LIW when it was built), never read from IW itself: IPOPT allocates IW
  * anew for each analysis and does not clear it, so it may hold what an earlier analysis left there (a header that
  * matched and a stale map once scattered out of bounds: a screen solve's segfault, docs/decisions.md). IW's header
- * (n, nz, nnzA, nnzL) is for ma27cd, which is given IW but not IKEEP. Systems with n < RECORD are analysed anew
+ * (nnzA, nnzL) is for ma27cd, which is given IW but not IKEEP. Systems with n < RECORD are analysed anew
  * at every factorisation.
  */
 #include <math.h>
@@ -31,7 +31,7 @@
 #include "amd.h"
 #include "qdldl.h"
 
-#define HDR 8
+#define HDR 2 /* IW's header: nnzA, nnzL */
 #define RECORD 6 /* IKEEP's entries after P and Pinv that this uses: n >= RECORD keeps them */
 #define WEAK 1e-7 /* a diagonal entry this small counts as zero for the ordering (IPOPT's delta_c <= 1e-8) */
 
@@ -246,7 +246,7 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
         if (pattern(n, nz, IRN, ICN, Pinv, Ap, scratch, map) != nnzA) { INFO[0] = -1; return; }
         memcpy(Ai, scratch, sizeof(int) * nnzA);
         if (QDLDL_etree(n, Ap, Ai, iwork, Lnz, etree) != nnzL) { INFO[0] = -1; return; }
-        IW[0] = n; IW[1] = nz; IW[2] = nnzA; IW[3] = nnzL;
+        IW[0] = nnzA; IW[1] = nnzL;
         if (record) record_workspace(record, IW, *LIW);
     }
     double *Ax = A + nz, *Lx = Ax + nnzA, *D = Lx + nnzL, *Dinv = D + n, *fwork = Dinv + n;
@@ -263,7 +263,7 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
 
 static void ma27c(int *N, double *A, int *IW, double *RHS) {
     int n = *N, i;
-    int nnzA = IW[2], nnzL = IW[3];
+    int nnzA = IW[0], nnzL = IW[1];
     int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
     int *Lnz = etree + n, *P = Lnz + n, *bwork = P + 3 * n;
     double *Lx = A + bwork[0], *Dinv = Lx + nnzL + n, *x = Dinv + 2 * n;
