@@ -89,6 +89,15 @@ def test_a_grown_start_keeps_the_shorter_structures_tool_path(small, where, big)
             grown_guess(problem(wrong), source, solution, at)
 
 
+def _found(q_d, cost, Q):
+    """A structure's best solution as the neighbour step reads it: tracking at ``cost``, its design ``q_d``, its
+    objective 1.5 x the cost and its joint values ``Q`` (one row per knot)."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
+                           raw=SimpleNamespace(q_d=q_d, objective=1.5 * cost, Q=Q))
+
+
 @pytest.mark.parametrize("shorter_cost, grown", [(1.0, [0, 1, 2]), (3.0, [])])
 def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_design(shorter_cost, grown):
     from types import SimpleNamespace
@@ -102,9 +111,7 @@ def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_des
     def searched(structure, cost):
         job = Job("sweep", problem_from_config(parse_config({"robot": {"dh": "generic", "structure": structure}})))
         moving = np.linspace(0.0, 1.0, 6)[:, None] * np.ones(len(structure))  # every joint moves
-        sol = SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
-                              raw=SimpleNamespace(q_d=job.problem.chain.design_values, objective=1.5 * cost, Q=moving))
-        return Searched(job, [], [(SimpleNamespace(), sol)])
+        return Searched(job, [], [(SimpleNamespace(), _found(job.problem.chain.design_values, cost, moving))])
 
     plan = neighbour_stage.plan([searched("RRP", shorter_cost), searched("RRRP", 2.0)], preset("quick"))
     tasks = next(plan, [])
@@ -186,9 +193,7 @@ def test_a_structure_is_pruned_from_a_longer_one_only_when_its_first_joint_stays
         Q = np.linspace(0.0, 1.0, 6)[:, None] * np.ones(len(structure))
         if still:
             Q[:, 0] = 0.1
-        sol = SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
-                              raw=SimpleNamespace(q_d=job.problem.chain.design_values, objective=1.5 * cost, Q=Q))
-        return Searched(job, [], [(SimpleNamespace(), sol)])
+        return Searched(job, [], [(SimpleNamespace(), _found(job.problem.chain.design_values, cost, Q))])
 
     tasks = next(neighbour_stage.plan([searched("RRP", 3.0), searched("RRRP", 2.0)], preset("quick")), [])
     pruned = [t for t in tasks if isinstance(t.start, Pruned)]
@@ -207,9 +212,7 @@ def test_a_second_pass_starts_only_from_the_structures_the_first_pass_lowered():
 
     def solution(structure, cost):
         Q = np.linspace(0.0, 1.0, 6)[:, None] * np.ones(len(structure))
-        return SimpleNamespace(metrics=SimpleNamespace(tracks=True, design_cost=cost),
-                               raw=SimpleNamespace(q_d=_structure_problem(structure).chain.design_values,
-                                                   objective=1.5 * cost, Q=Q))
+        return _found(_structure_problem(structure).chain.design_values, cost, Q)
 
     searched = [Searched(Job("sweep", _structure_problem(s)), [], [(SimpleNamespace(), solution(s, c))])
                 for s, c in (("RRP", 3.0), ("RRR", 4.0), ("RPP", 5.0))]
