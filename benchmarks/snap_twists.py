@@ -24,6 +24,7 @@ import pandas as pd
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
 from designopt.initial_guess import projected
+from designopt.modular import distinct_optima
 from designopt.problem import problem_from_config
 from designopt.solution import read_solution_for
 from designopt.solve.local import solve_guess
@@ -60,14 +61,9 @@ def main() -> None:
         problem = problem_from_config(cfg)
         profile = search_from_config(cfg).profile.warmed().with_options(**{"ipopt.mu_init": args.mu})
         summary = pd.read_csv(run / "summary.csv")
-        final = summary[summary.tracks & summary.stage.str.startswith(("refine", "reflect"))].sort_values("design_cost")
-        taken: list[float] = []
-        for _, row in final.iterrows():
-            if any(abs(row.design_cost / c - 1) < 1e-3 for c in taken):
-                continue
-            if len(taken) == args.top:
-                break
-            taken.append(row.design_cost)
+        final = summary[summary.tracks & summary.stage.str.startswith(("refine", "reflect"))]
+        for i in distinct_optima(list(final.design_cost.items()), args.top, rel_tol=1e-3):
+            row = final.loc[i]
             sol = read_solution_for(problem, Collocation(), run / row.solution_file)
             q_d, moved = snapped(problem.chain, sol.raw.q_d)
             t = problem.toolpath.t
