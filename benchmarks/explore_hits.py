@@ -7,12 +7,16 @@ search's settings unless given), each compared with the best design known lifted
 solved warm there. A start *hits* when it ends within 1.02x / 1.10x of that cost. Hundreds of starts take about
 a minute, where the seed distribution of `search_seeds.py` takes 20 full runs: use this to compare ways of
 starting (``--spread box``: designs from the task's box and first joints over the whole circle,
-`designopt.initial_guess.box_design`, instead of perturbing the configured design by ``--scale``), then judge the
-search that uses the better one on the seed distribution.
+`designopt.initial_guess.box_design`, instead of perturbing the configured design by ``--scale``; ``--init home``:
+IK walks pulled towards their first waypoint's configuration), then judge the search that uses the better one on
+the seed distribution. ``--at-reference``: every start at the best design known itself, on a new joint branch
+(`designopt.solve.starts.Rebranched` of its coarse solution: first joints over the whole circle): does the walk
+find that design's basin when the design is right?
 
     .venv/bin/python benchmarks/explore_hits.py [--config configs/milling.yaml]
         [--reference benchmarks/reference/milling_best_known.json] [--first-seed 100] [--seeds 5] [--starts 80]
-        [--scale 0.3 | --spread box] [--waypoints 10] [--max-iter 250] [--jobs 2] [--option ipopt.KEY=VALUE ...]
+        [--scale 0.3 | --spread box] [--init ik|home|reach] [--at-reference] [--waypoints 10] [--max-iter 250]
+        [--jobs 2] [--option ipopt.KEY=VALUE ...]
 """
 
 from __future__ import annotations
@@ -26,10 +30,11 @@ import numpy as np
 from solver_options import parse_options
 
 from designopt.config import load_config
-from designopt.initial_guess import SPREADS
+from designopt.initial_guess import INIT_MODES, SPREADS
 from designopt.problem import problem_from_config
 from designopt.solution import read_solution_for
 from designopt.solve import Job, Lifted, Seeded, Task, fan_out, preset
+from designopt.solve.starts import Rebranched
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
 from designopt.solve.strategies.steps import solve_setup
 from designopt.transcriptions import Collocation
@@ -45,6 +50,9 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--starts", type=int, default=80, help="starts per seed")
     parser.add_argument("--spread", choices=SPREADS, default="perturb")
+    parser.add_argument("--init", choices=INIT_MODES, default=None, help="how starts walk (default: the search's)")
+    parser.add_argument("--at-reference", action="store_true",
+                        help="start at the best design known, on new joint branches (its coarse solution rebranched)")
     parser.add_argument("--scale", type=float, default=None, help="perturbation (default: the search's)")
     parser.add_argument("--waypoints", type=int, default=None, help="default: the search's explore_waypoints")
     parser.add_argument("--max-iter", type=int, default=None, help="default: the search's explore_max_iter")
@@ -70,8 +78,10 @@ def main() -> None:
     profile = replace(profile, options=(*profile.options, *parse_options(args.option)))
     seeds = range(args.first_seed, args.first_seed + args.seeds)
 
+    init = args.init or search.init
     tasks = [Task("hits", "explore", coarse, Collocation(), profile,
-                  Seeded(s, i, scale, search.init, spread=args.spread), hold)
+                  Rebranched(ref, s, i, init) if args.at_reference else Seeded(s, i, scale, init, spread=args.spread),
+                  hold)
              for s in seeds for i in range(args.starts)]
     t0 = time.perf_counter()
     done = list(fan_out(tasks, args.jobs))
@@ -80,6 +90,8 @@ def main() -> None:
     cpu = sum(sol.raw.solve_time_s for _, sol in done)
     n = len(ratio)
     how = "the task's box" if args.spread == "box" else f"perturbation {scale}"
+    how = "at the best design known, new joint branches" if args.at_reference else how
+    how += f", init {init}"
     how += "".join(f", {k} {v}" for k, v in parse_options(args.option))
     print(f"{args.config}: {n} starts ({len(seeds)} seeds x {args.starts}; {how}) on {waypoints} waypoints, "
           f"<= {args.max_iter or search.explore_max_iter} iterations; best known there {known:.4g}")

@@ -179,6 +179,46 @@ def test_a_lifted_start_is_on_the_path_between_the_coarse_knots(milling_12):
     assert np.sum(lifted < 1e-6) >= tp.n - 1
 
 
+CIRCLE_12 = {"name": "circle_12", "toolpath": {"kind": "circle", "radius": 0.15, "waypoints": 12, "force": 1.0},
+             "robot": {"structure": "RRRRRR", "dh": "puma560"}, "placement": {"xyz": [0.5, 0.0, -0.2]}}
+
+
+def test_the_home_walk_ends_where_it_began_around_a_closed_path():
+    """Perturbed starts of a 6R arm (twists off the lattice, so the arm turns about more than its last joint to
+    keep the tool on the path: redundant by one for a tool whose spin is free), walked around a closed circle.
+    The ``ik`` walk's minimum-norm steps end elsewhere on the self-motion than they began on almost every start
+    (the pseudoinverse is not repeatable); ``home``, pulled towards the first configuration, ends where it began on
+    every walk that stays on the path (every waypoint within 1e-6), and stays on it as often."""
+    problem = problem_from_config(parse_config(CIRCLE_12))
+    tp = problem.toolpath
+    fn = residual_function(problem)
+    assert np.abs(tp.points_W[0] - tp.points_W[-1]).max() < 1e-12  # the premise: a closed path
+
+    def walked(mode):  # (on the path, gap between the last and first configurations) per start
+        out = []
+        for i in range(1, 41):
+            guess = initial_guess(problem, i, 11, 0.3, mode)
+            Q = guess.Q
+            on = max(np.linalg.norm(np.array(fn(Q[k], guess.q_d, tp.points_W[k])[0])) for k in range(tp.n)) < 1e-6
+            out.append((on, np.abs(Q[-1] - Q[0]).max()))
+        return np.array(out)
+
+    free, pulled = walked("ik"), walked("home")
+    on_free, on_pulled = free[:, 0] > 0, pulled[:, 0] > 0
+    assert on_free.sum() >= 15 and (free[on_free, 1] > 1e-3).sum() >= 0.8 * on_free.sum()  # the ik walk drifts
+    assert on_pulled.sum() >= on_free.sum()
+    assert pulled[on_pulled, 1].max() < 1e-3
+
+
+def test_an_arm_without_self_motion_walks_home_as_ik_does():
+    """The PUMA-560 as configured: its only self-motion for a tool whose spin is free is its last joint turning
+    about the tool axis, which no walk moves; the pull has nothing to act on, and ``home`` is the ``ik`` walk to
+    the bit, from any first configuration."""
+    problem = problem_from_config(parse_config(CIRCLE_12))
+    for seed in range(5):  # start 0 keeps the configured design
+        assert np.array_equal(initial_guess(problem, 0, seed, 0.3, "home").Q, initial_guess(problem, 0, seed, 0.3).Q)
+
+
 def test_projection_moves_joints_onto_the_path_and_keeps_their_branch(milling_12_slow):
     """Joints on an IK trajectory, disturbed by 0.05 rad, return to the path near where they were (the arm is
     redundant for a tool whose spin is free, so not to the same joints); rows already on the path do not move."""

@@ -26,7 +26,8 @@ class Search:
     """A strategy and its budget. Counts are per problem; iteration caps per solve.
 
     ``starts`` seeded starts (from ``seed``; designs by ``spread``: perturbed by ``perturbation``, drawn from the
-    task's box, or mixed, odd starts from the box, `designopt.initial_guess`; joints by ``init``): cold starts on
+    task's box, or mixed, odd starts from the box, `designopt.initial_guess`; joints by ``init``: ik, home, reach
+    or constant): cold starts on
     the full path for ``multistart``; for ``coarse_to_fine`` the exploration's starts on ``explore_waypoints`` of
     the path's waypoints (each capped at ``explore_max_iter``), then the ``rebranch`` best distinct of their optima
     (at most ``rebranch_per_form`` of one form, the pattern of the arm's joint axes, before other forms:
@@ -99,6 +100,8 @@ class Search:
         cap = f"<= {self.profile.max_iter} iterations"
         drawn = {"perturb": "", "box": " drawn from the task's box",
                  "mixed": " (every other one drawn from the task's box)"}[self.spread]
+        if self.init == "home":
+            drawn += " (their IK walks pulled towards the first waypoint's configuration)"
         reflect = (f", then the best reflected across its length bounds (up to {self.reflect} rounds)" if self.reflect
                    else "")
         if self.strategy == "multistart":
