@@ -92,7 +92,7 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     its first configuration. Minimum-norm steps alone (``home_pull`` 0) are not repeatable: around a closed path
     they drift along the self-motion, and the solver then spends the start undoing the drift (on 40 perturbed
     starts of a 12-waypoint circle, `tests/test_search.py`, 2 of the 25 walks on the path ended within 1e-3 of
-    where they began; pulled, 25 of 25). Where dr/dq has no null space, or only joints the walk never moves (a
+    where they began; pulled, 27 of 27). Where dr/dq has no null space, or only joints the walk never moves (a
     last joint turning about the tool axis), the walk is the minimum-norm walk to the bit."""
     fn = point_residual(problem)
     points = problem.toolpath.points_W
@@ -101,7 +101,7 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
         r, J_q = fn(q, q_d, points[k])
         return r.ravel(), J_q
 
-    def towards_home(q, J):  # the self-motion step towards q0, at most HOME_STEP long
+    def towards_home(q, J):  # the self-motion step towards the home posture, at most HOME_STEP long
         _, s, Vt = np.linalg.svd(J)
         rank = int((s > 1e-6 * max(s[0], 1e-12)).sum()) if len(s) else 0
         N = Vt[rank:].T
