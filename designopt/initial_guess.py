@@ -113,12 +113,17 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     hi = np.array([j.upper for j in problem.chain.moving])
     Q = np.empty((problem.toolpath.n, len(q0)))
     q = np.array(q0, dtype=float)
-    home = q  # the first waypoint's own configuration, once walked to (the first waypoint is walked unpulled)
+    home = None  # the first waypoint's own configuration, once walked to (the first waypoint is walked unpulled)
     eye = np.eye(len(q))
     for k in range(problem.toolpath.n):
         damping, pull = 1e-2, home_pull if k else 0.0
         r, J = residual(q, k)
-        for _ in range(iterations if k == 0 else max(8, iterations // 3)):
+        pulled = iterations if k == 0 else max(8, iterations // 3)
+        for i in range(pulled + (POLISH if home_pull else 0)):
+            if i == pulled:  # the pull may have stopped short of the path: back onto it without the pull
+                pull = 0.0
+                if r @ r < 1e-14:
+                    break
             step = np.linalg.solve(J.T @ J + damping * eye, -J.T @ r)
             home_step = pull * towards_home(q, J) if pull else 0.0
             trial = np.clip(q + step + home_step, lo, hi)
@@ -129,15 +134,6 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
                 damping, pull = damping * 5, pull / 2
             if r @ r < 1e-14 and np.linalg.norm(home_step) < 1e-6:
                 break
-        for _ in range(POLISH if home_pull else 0):  # the pull may stop short of the path: back onto it
-            if r @ r < 1e-14:
-                break
-            trial = np.clip(q + np.linalg.solve(J.T @ J + damping * eye, -J.T @ r), lo, hi)
-            r_new, J_new = residual(trial, k)
-            if r_new @ r_new < r @ r:
-                q, r, J, damping = trial, r_new, J_new, max(damping / 3, 1e-6)
-            else:
-                damping *= 5
         Q[k] = q
         if k == 0:
             home = q.copy()
