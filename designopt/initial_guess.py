@@ -93,7 +93,9 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     they drift along the self-motion, and the solver then spends the start undoing the drift (on 40 perturbed
     starts of a 12-waypoint circle, `tests/test_search.py`, 2 of the 25 walks on the path ended within 1e-3 of
     where they began; pulled, 27 of 27). Where dr/dq has no null space, or only joints the walk never moves (a
-    last joint turning about the tool axis), the walk is the minimum-norm walk to the bit."""
+    last joint turning about the tool axis), the walk is the minimum-norm walk to the bit wherever that reaches the
+    path (residual below 1e-7) within its iterations; at a waypoint it does not reach (an arm with too few joints
+    for the path, a point out of reach) the `POLISH` iterations walk on, so the start differs there too."""
     fn = point_residual(problem)
     points = problem.toolpath.points_W
 

@@ -59,7 +59,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     # a config without `search` gets the library's default search; its three keys each change what runs
     assert search_from_config(parse_config({})) == PRESETS["default"]
-    assert PRESETS["default"] == Search(starts=160, screen=24, explore_linear_solver="ldl",
+    assert PRESETS["default"] == Search(starts=160, screen=24, init="home", explore_linear_solver="ldl",
                                         screen_mu_init=(None, 1e-6), refine_mu_init=(None, 1e-6),
                                         rebranch_new_forms=2, reflect=3)
     for name in PRESETS:
@@ -72,7 +72,8 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert boxed == replace(PRESETS["default"], spread="box")
     (task, *_) = seeded_tasks(Job("", coarse_problem(problem_from_config(parse_config({})), 10)), "explore",
                               None, None, boxed, 2)
-    assert task.start.spread == "box"
+    assert (task.start.spread, task.start.init) == ("box", "home")
+    assert "pulled towards the first waypoint's configuration" in PRESETS["default"].describe()
     assert "drawn from the task's box" in boxed.describe() and "box" not in PRESETS["default"].describe()
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, refine=4, reflect=3, seed=2,

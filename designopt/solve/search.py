@@ -179,8 +179,13 @@ PRESETS: dict[str, Search] = {
     # (docs/benchmarks.md, "Search"; docs/decisions.md, 2026-11-26/27). Then the answer reflected across its length
     # bounds, up to 3 rounds (`reflect`): on seeds 1421-1440 (main job) and 1401-1420 (the other two), replays of the
     # default's runs, seeds better / worse 3 / 0, 9 / 0, 5 / 0 (main job worst 1.330 -> 1.209x, the circle's median
-    # 1.898 -> 1.743x) at 1.002x, 1.035x, 1.022x the solve time
-    "default": Search(starts=160, screen=24, explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
+    # 1.898 -> 1.743x) at 1.002x, 1.035x, 1.022x the solve time. Every start's IK walk pulled home (`init: home`:
+    # around a closed path the minimum-norm walk drifts along a redundant arm's self-motion): on seeds never run
+    # before, within 1.10x of the best known circle 5 -> 10 of 20 (median 2.053 -> 1.386x; seeds 1441-1460),
+    # physical stiffness 14 -> 18 of 20 (worst 1.344 -> 1.177x; 1441-1460), main job 35 -> 36 of 40 (p90 1.163 ->
+    # 1.065x, worst 1.278 -> 1.245x; 1481-1520, seeds better / worse 10 / 10; on 1461-1480 before it 4 / 5, worst
+    # 1.238 -> 1.211x), at 0.99-1.02x the solve time (docs/benchmarks.md, "IK walks pulled home")
+    "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
                       refine_mu_init=(None, 1e-6), rebranch_new_forms=2, reflect=3),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
