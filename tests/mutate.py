@@ -284,6 +284,8 @@ MUTATIONS = [
     Mutation("the KKT solver eliminates a zero-diagonal row where AMD put it", "designopt/solve/backends/ldl/ma27.c",
              "if (partner < 0) { waiting[u] = 1; continue; }", "if (0) { waiting[u] = 1; continue; }",
              ("tests/test_ldl.py",)),
+    Mutation("the KKT solver lets a constraint row follow any eliminated neighbour, not its own (as before 2026-11-28)",
+             "designopt/solve/backends/ldl/ma27.c", "if (n >= MATCHED_FROM) {", "if (0) {", ("tests/test_ldl.py",)),
     Mutation("the KKT solver orders a regularised constraint row (-1e-8) as a pivot",
              "designopt/solve/backends/ldl/ma27.c",
              "zero[j] = fabs(diag[j]) <= WEAK;", "zero[j] = diag[j] == 0.0;", ("tests/test_ldl.py",)),

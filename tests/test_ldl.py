@@ -5,6 +5,7 @@ reported as such; and IPOPT through it reaching a problem's known optimum."""
 from __future__ import annotations
 
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -54,6 +55,28 @@ def test_kkt_solves_and_inertia_match_dense_linear_algebra(seed):
         x = solver.solve(b)
         expected = np.linalg.solve(K, b)
         assert np.linalg.norm(x - expected) <= 1e-8 * max(1.0, np.linalg.norm(expected))
+
+
+def test_a_kkt_system_near_convergence_keeps_its_digits():
+    """A KKT matrix IPOPT factorised near the end of a 40-waypoint screen solve of the main job (mu = 1e-9; 1,720
+    rows: 504 variables, 508 slacks, 708 multipliers; `tests/data/kkt_screen_late.npz`, written by a copy of the
+    library that saved every matrix it was given). When each waypoint's tracking rows waited for any eliminated
+    neighbour, four of five rows shared one joint, their pivots fell to -delta_c and the design joints' pivots
+    lost their digits: 709 negative pivots reported and a relative residual of 0.13. Each row waiting for a
+    neighbour of its own keeps them: numpy's inertia and solution."""
+    data = np.load(Path(__file__).parent / "data" / "kkt_screen_late.npz")
+    n, rows, cols, values = int(data["n"]), data["rows"].astype(int), data["cols"].astype(int), data["values"]
+    K = np.zeros((n, n))
+    np.add.at(K, (rows, cols), values)
+    K = K + K.T - np.diag(np.diag(K))
+    lib = Ma27(n, rows, cols)
+    info = lib.factorise(values)
+    assert info[0] == 0
+    assert info[14] == np.sum(np.linalg.eigvalsh(K) < 0) == 708  # the multipliers' count: the inertia IPOPT wants
+    b = np.random.default_rng(0).standard_normal(n)
+    x = lib.solve(b)
+    assert np.linalg.norm(K @ x - b) <= 1e-8 * np.linalg.norm(b)
+    assert np.allclose(x, np.linalg.solve(K, b), rtol=0, atol=1e-8 * np.linalg.norm(x))
 
 
 def test_duplicate_and_upper_triangle_triplets_are_summed_as_ma27_does():

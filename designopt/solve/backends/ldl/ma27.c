@@ -34,6 +34,7 @@
 #define HDR 2 /* IW's header: nnzA, nnzL */
 #define RECORD 6 /* IKEEP's entries after P and Pinv that this uses: n >= RECORD keeps them */
 #define WEAK 1e-7 /* a diagonal entry this small counts as zero for the ordering (IPOPT's delta_c <= 1e-8) */
+#define MATCHED_FROM 1000 /* from this many rows, a constraint row waits for a neighbour of its own (defer_zero_pivots) */
 
 static int ints_needed(int n, int nz, int nnzA, int nnzL) {
     return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + 3 * n + n + nz + (2 * nz + 2 * n);
@@ -105,38 +106,97 @@ static void adjacency(int n, int nz, const int *IRN, const int *ICN, int *Cp, in
     }
 }
 
+/* For every zero-diagonal node (a constraint row), a neighbour of its own to be eliminated before it (match[u], or
+ * -1 if none is left): a variable with a nonzero diagonal that no other constraint row is given and that is not a
+ * dense column (more than n / 10 neighbours: the design joints, which AMD puts last). Greedy, the rows with the
+ * fewest candidates first; each takes the candidate with the fewest constraint-row neighbours (a slack, whose only
+ * one is its own row, before a joint), then the largest |a_uv| of the matrix given. Cp, Ci, Cx: both triangles'
+ * off-diagonal pattern and values. Returns 0, or -1 when out of memory. */
+static int own_neighbours(int n, const int *Cp, const int *Ci, const double *Cx, const char *zero, int *match) {
+    int j, q, r, nrows = 0, dense = n / 10;
+    int *zn = (int *)calloc(n, sizeof(int)), *rows = (int *)malloc(sizeof(int) * (n + 1));
+    int *count = (int *)calloc(n, sizeof(int)), *bucket = (int *)calloc(n + 2, sizeof(int));
+    char *taken = (char *)calloc(n, 1);
+    if (!zn || !rows || !count || !bucket || !taken) {
+        free(zn); free(rows); free(count); free(bucket); free(taken);
+        return -1;
+    }
+    for (j = 0; j < n; j++) {
+        match[j] = -1;
+        for (q = Cp[j]; q < Cp[j + 1]; q++)
+            if (zero[Ci[q]]) zn[j]++;
+    }
+    for (j = 0; j < n; j++) { /* each row's candidates, counted; then the rows by that count (a stable counting sort) */
+        if (!zero[j]) continue;
+        for (q = Cp[j]; q < Cp[j + 1]; q++)
+            if (!zero[Ci[q]] && Cp[Ci[q] + 1] - Cp[Ci[q]] <= dense) count[j]++;
+        bucket[count[j] + 1]++;
+        nrows++;
+    }
+    for (j = 0; j <= n; j++) bucket[j + 1] += bucket[j];
+    for (j = 0; j < n; j++)
+        if (zero[j]) rows[bucket[count[j]]++] = j;
+    for (r = 0; r < nrows; r++) {
+        int u = rows[r], best = -1;
+        double size = 0.0;
+        for (q = Cp[u]; q < Cp[u + 1]; q++) {
+            int v = Ci[q];
+            double a = fabs(Cx[q]);
+            if (zero[v] || taken[v] || Cp[v + 1] - Cp[v] > dense || a == 0.0) continue;
+            if (best < 0 || zn[v] < zn[best] || (zn[v] == zn[best] && a > size)) { best = v; size = a; }
+        }
+        if (best >= 0) { match[u] = best; taken[best] = 1; }
+    }
+    free(zn); free(rows); free(count); free(bucket); free(taken);
+    return 0;
+}
+
 /* The ordering P (new -> old) changed so that no node whose diagonal is zero (a constraint row of IPOPT's KKT
  * matrix, whether delta_c is 0 or 1e-8 mu^0.25) is eliminated before one of its neighbours: its pivot is then the
- * fill its eliminated neighbours left (-J^2 / H) instead of an exact zero or -delta_c. Not a guarantee: two rows
- * whose only eliminated neighbour is the same variable leave a rank-one block, whose second pivot is zero (reported
- * as singular) or tiny (benchmarks/kkt_ldl.py counts how often). Nodes keep AMD's order otherwise; a deferred node
+ * fill that neighbour left (-a_uv^2 / h) instead of an exact zero or -delta_c. From `MATCHED_FROM` rows on, the
+ * neighbour must be the row's own (`own_neighbours`; a row without one waits for any): rows whose only eliminated
+ * neighbour is the same variable (a waypoint's five tracking rows and one of its joints) leave a rank-one block
+ * after it, the first row's pivot takes it and the others' fall to -delta_c (5.6e-11 at mu = 1e-9), whose fill
+ * (1e10) leaves the design joints' pivots, eliminated last, without the digits their signs need: near
+ * convergence a false wrong inertia on about half the factorisations of a 40-waypoint screen, and IPOPT
+ * regularising every iteration (docs/decisions.md, 2026-11-28). Nodes keep AMD's order otherwise; a deferred node
  * follows the node that frees it. Returns 0, or -1 when out of memory. */
 static int defer_zero_pivots(int n, int nz, const int *IRN, const int *ICN, const double *A, int *P, int *Pinv) {
     int j, k, q, placed = 0;
-    double *diag = (double *)calloc(n, sizeof(double));
+    double *diag = (double *)calloc(n, sizeof(double)), *Cx = (double *)malloc(sizeof(double) * (2 * nz + 1));
     char *zero = (char *)malloc(n), *done = (char *)calloc(n, 1), *waiting = (char *)calloc(n, 1);
     int *Cp = (int *)calloc(n + 1, sizeof(int)), *Ci = (int *)malloc(sizeof(int) * (2 * nz + 1));
     int *fill = (int *)malloc(sizeof(int) * (n + 1)), *order = (int *)malloc(sizeof(int) * (n + 1));
-    int *stack = (int *)malloc(sizeof(int) * (2 * nz + n + 1));
-    if (!diag || !zero || !done || !waiting || !Cp || !Ci || !fill || !order || !stack) {
-        free(diag); free(zero); free(done); free(waiting); free(Cp); free(Ci); free(fill); free(order);
-        free(stack);
-        return -1;
-    }
+    int *stack = (int *)malloc(sizeof(int) * (2 * nz + n + 1)), *match = (int *)malloc(sizeof(int) * (n + 1));
+    int status = -1;
+    if (!diag || !Cx || !zero || !done || !waiting || !Cp || !Ci || !fill || !order || !stack || !match) goto out;
     for (k = 0; k < nz; k++)
         if (IRN[k] == ICN[k]) diag[IRN[k] - 1] += A[k];
     /* zero, or as good as zero: a regularised constraint row's -delta_c (1e-8 mu^0.25) is no pivot to divide by */
     for (j = 0; j < n; j++) zero[j] = fabs(diag[j]) <= WEAK;
     adjacency(n, nz, IRN, ICN, Cp, Ci, fill);
+    memcpy(fill, Cp, sizeof(int) * (n + 1)); /* the values, into the slots adjacency() filled, in the same order */
+    for (k = 0; k < nz; k++) {
+        int a = IRN[k] - 1, b = ICN[k] - 1;
+        if (a != b) { Cx[fill[b]++] = A[k]; Cx[fill[a]++] = A[k]; }
+    }
+    if (n >= MATCHED_FROM) {
+        if (own_neighbours(n, Cp, Ci, Cx, zero, match) < 0) goto out;
+    } else {
+        for (j = 0; j < n; j++) match[j] = -1;
+    }
     for (j = 0; j < n; j++) {
         int top = 0;
         stack[top++] = P[j];
         while (top > 0) { /* a node, then every waiting node it may free, in turn */
             int u = stack[--top], partner = -1;
             if (done[u]) continue;
-            if (zero[u]) { /* waits for an eliminated neighbour */
-                for (q = Cp[u]; q < Cp[u + 1] && partner < 0; q++)
-                    if (done[Ci[q]]) partner = Ci[q];
+            if (zero[u]) { /* waits for its own neighbour, or for any eliminated one if it has none */
+                if (match[u] >= 0)
+                    partner = done[match[u]] ? match[u] : -1;
+                else
+                    for (q = Cp[u]; q < Cp[u + 1] && partner < 0; q++)
+                        if (done[Ci[q]]) partner = Ci[q];
                 if (partner < 0) { waiting[u] = 1; continue; }
             }
             done[u] = 1;
@@ -150,8 +210,11 @@ static int defer_zero_pivots(int n, int nz, const int *IRN, const int *ICN, cons
         if (!done[P[j]]) { done[P[j]] = 1; order[placed++] = P[j]; }
     memcpy(P, order, sizeof(int) * n);
     for (j = 0; j < n; j++) Pinv[P[j]] = j;
-    free(diag); free(zero); free(done); free(waiting); free(Cp); free(Ci); free(fill); free(order); free(stack);
-    return 0;
+    status = 0;
+out:
+    free(diag); free(Cx); free(zero); free(done); free(waiting); free(Cp); free(Ci); free(fill); free(order);
+    free(stack); free(match);
+    return status;
 }
 
 /* nnzA and nnzL of ordering Pinv, or -1. */
