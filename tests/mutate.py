@@ -298,6 +298,8 @@ MUTATIONS = [
     Mutation("the exploration factorised by the profile's linear solver, not the search's",
              "designopt/solve/strategies/coarse_to_fine.py", ".solved_by(search.explore_linear_solver)", "",
              ("tests/test_search.py",)),
+    Mutation("a long program's Hessian perturbation left unbounded under MUMPS", "designopt/solve/backends/ipopt.py",
+             'opts["ipopt.max_hessian_perturbation"] = 1e8', "pass", ("tests/test_ldl.py",)),
     Mutation("a profile's linear solver ignored (every solve by MUMPS)", "designopt/solve/backends/ipopt.py",
              "or profile.linear_solver", 'or "mumps"', ("tests/test_ldl.py",)),
     Mutation("compile auto never compiles a long path's blocks at O1", "designopt/transcriptions/compiled.py",

@@ -139,6 +139,20 @@ def test_ipopt_through_the_ldl_reaches_the_known_optimum(monkeypatch):
     assert sol.metrics.design_cost == pytest.approx(4.0 * N / (N - 1), rel=1e-9)
 
 
+def test_a_long_programs_hessian_perturbation_is_bounded_under_mumps(monkeypatch):
+    """From `BOUNDED_PERTURBATION_FROM` variables on, MUMPS's solves hold IPOPT's Hessian perturbation below 1e8 (a
+    perturbation of 1e10 kept MUMPS in one factorisation past the start's time limit); smaller problems keep IPOPT's
+    own limit, and a profile's options still win."""
+    monkeypatch.delenv("DESIGNOPT_LINEAR_SOLVER", raising=False)
+    big = ipopt_backend.BOUNDED_PERTURBATION_FROM
+    assert ipopt_backend.options(SolverProfile(), big)["ipopt.max_hessian_perturbation"] == 1e8
+    assert "ipopt.max_hessian_perturbation" not in ipopt_backend.options(SolverProfile(), big - 1)
+    if ldl.library() is not None:  # the LDLᵀ's factors have a fixed pattern: nothing to bound
+        assert "ipopt.max_hessian_perturbation" not in ipopt_backend.options(SolverProfile(linear_solver="ldl"), big)
+    own = SolverProfile(options=(("ipopt.max_hessian_perturbation", 1e12),))
+    assert ipopt_backend.options(own, big)["ipopt.max_hessian_perturbation"] == 1e12
+
+
 def test_the_linear_solver_is_chosen_by_name(monkeypatch):
     """A profile names it, ``DESIGNOPT_LINEAR_SOLVER`` overrides every profile; an unknown name is refused; ldl
     falls back to MUMPS without a compiler."""

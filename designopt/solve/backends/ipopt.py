@@ -46,6 +46,13 @@ OBSERVE_EVERY = 5
 # variables), 0.90 on the main job (80, 984), 1.02 on the pocket cell, but 1.15 on the exploration problem
 # (10, ~150 variables; 24 starts).
 METIS_FROM = 400
+# From this many variables on, IPOPT's Hessian perturbation is held below 1e8 (its own limit is 1e20). On a long
+# program (benchmarks/configs/aluminum_button.yaml, 21,744 variables, start 3) an iteration that had lost its way
+# asked for 1e10, and MUMPS then sat in one factorisation for over 6 minutes at 6 GB -- past the start's time
+# limit, which IPOPT checks between iterations only; with the bound that start converges in 133 iterations, 34 s.
+# Smaller problems are left as they were: on the paper's continuous comparison (984 variables) the bound changed 10
+# of 72 solves (docs/decisions.md, 2026-11-28).
+BOUNDED_PERTURBATION_FROM = 5000
 def linear_solver(profile) -> str:
     """The linear solver of a profile's solves: the profile's ``linear_solver``, unless the environment's
     ``DESIGNOPT_LINEAR_SOLVER`` names one for every solve of the process (to compare the two; docs/benchmarks.md);
@@ -63,6 +70,8 @@ def options(profile, n_variables: int = 0) -> dict:
         opts |= {"ipopt.linear_solver": "ma27", "ipopt.hsllib": str(ldl.library())}
     elif n_variables >= METIS_FROM:
         opts["ipopt.mumps_pivot_order"] = 5
+        if n_variables >= BOUNDED_PERTURBATION_FROM:
+            opts["ipopt.max_hessian_perturbation"] = 1e8
     return {**opts, **(WARM_OPTIONS if profile.warm else {}), **dict(profile.options)}
 
 
