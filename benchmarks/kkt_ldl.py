@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from designopt.solve.backends import ldl
-from designopt.solve.backends.ldl.check import Ma27, random_kkt
+from designopt.solve.backends.ldl.check import Ma27, dense, random_kkt
 
 
 def check(seeds: int = 50) -> None:
@@ -100,9 +100,7 @@ def replay(folder: Path, every: int, library: Path | None) -> None:
         info = solver.factorise(values)
         if k % every:
             continue
-        K = np.zeros((n, n))
-        np.add.at(K, (rows, cols), values)
-        K = K + K.T - np.diag(np.diag(K))
+        K = dense(n, rows, cols, values)
         negative, b = int(np.sum(np.linalg.eigvalsh(K) < 0)), rng.normal(size=n)
         residual = np.linalg.norm(K @ solver.solve(b) - b) / np.linalg.norm(b) if info[0] == 0 else np.inf
         checked, worst = checked + 1, max(worst, residual)

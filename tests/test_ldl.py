@@ -16,7 +16,7 @@ from designopt.initial_guess import initial_guesses
 from designopt.problem import problem_from_config
 from designopt.solve.backends import ipopt as ipopt_backend
 from designopt.solve.backends import ldl
-from designopt.solve.backends.ldl.check import Ma27, random_kkt
+from designopt.solve.backends.ldl.check import Ma27, dense, random_kkt
 from designopt.solve.profile import SolverProfile
 
 
@@ -66,9 +66,7 @@ def test_a_kkt_system_near_convergence_keeps_its_digits():
     neighbour of its own keeps them: numpy's inertia and solution."""
     data = np.load(Path(__file__).parent / "data" / "kkt_screen_late.npz")
     n, rows, cols, values = int(data["n"]), data["rows"].astype(int), data["cols"].astype(int), data["values"]
-    K = np.zeros((n, n))
-    np.add.at(K, (rows, cols), values)
-    K = K + K.T - np.diag(np.diag(K))
+    K = dense(n, rows, cols, values)
     lib = Ma27(n, rows, cols)
     info = lib.factorise(values)
     assert info[0] == 0

@@ -53,6 +53,8 @@ METIS_FROM = 400
 # Smaller problems are left as they were: on the paper's continuous comparison (984 variables) the bound changed 10
 # of 72 solves (docs/decisions.md, 2026-11-28).
 BOUNDED_PERTURBATION_FROM = 5000
+
+
 def linear_solver(profile) -> str:
     """The linear solver of a profile's solves: the profile's ``linear_solver``, unless the environment's
     ``DESIGNOPT_LINEAR_SOLVER`` names one for every solve of the process (to compare the two; docs/benchmarks.md);
@@ -68,8 +70,9 @@ def options(profile, n_variables: int = 0) -> dict:
     opts = {**BASE_OPTIONS, "ipopt.max_iter": int(profile.max_iter), "ipopt.max_wall_time": float(profile.time_limit)}
     if linear_solver(profile) == "ldl":
         opts |= {"ipopt.linear_solver": "ma27", "ipopt.hsllib": str(ldl.library())}
-    elif n_variables >= METIS_FROM:
-        opts["ipopt.mumps_pivot_order"] = 5
+    else:  # MUMPS
+        if n_variables >= METIS_FROM:
+            opts["ipopt.mumps_pivot_order"] = 5
         if n_variables >= BOUNDED_PERTURBATION_FROM:
             opts["ipopt.max_hessian_perturbation"] = 1e8
     return {**opts, **(WARM_OPTIONS if profile.warm else {}), **dict(profile.options)}

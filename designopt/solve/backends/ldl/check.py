@@ -64,6 +64,13 @@ class Ma27:
         return x
 
 
+def dense(n: int, rows, cols, values) -> np.ndarray:
+    """The symmetric n x n matrix of (0-based) triplets from either triangle, duplicates summed, as MA27 reads them."""
+    K = np.zeros((n, n))
+    np.add.at(K, (np.asarray(rows), np.asarray(cols)), values)
+    return K + K.T - np.diag(np.diag(K))
+
+
 def random_kkt(rng, n_x: int = 30, n_c: int = 12, band: int = 3, border: int = 2, delta_c: float = 0.0,
                definite: bool = False):
     """A KKT matrix shaped like the transcription's: a banded Hessian block (indefinite) with ``border`` dense

@@ -91,8 +91,10 @@ static int pattern(int n, int nz, const int *irn, const int *icn, const int *pin
 }
 
 /* The off-diagonal pattern of both triangles of the (1-based) triplets as 0-based columns: Cp[n+1] (zeroed by the
- * caller) and Ci[2 nz]; fill[n+1] is scratch. */
-static void adjacency(int n, int nz, const int *IRN, const int *ICN, int *Cp, int *Ci, int *fill) {
+ * caller) and Ci[2 nz]; with A and Cx given (else NULL), the triplets' values too, Cx[2 nz] beside Ci. fill[n+1] is
+ * scratch. */
+static void adjacency(int n, int nz, const int *IRN, const int *ICN, const double *A, int *Cp, int *Ci, double *Cx,
+                      int *fill) {
     int j, k;
     for (k = 0; k < nz; k++) {
         int a = IRN[k] - 1, b = ICN[k] - 1;
@@ -102,12 +104,15 @@ static void adjacency(int n, int nz, const int *IRN, const int *ICN, int *Cp, in
     memcpy(fill, Cp, sizeof(int) * (n + 1));
     for (k = 0; k < nz; k++) {
         int a = IRN[k] - 1, b = ICN[k] - 1;
-        if (a != b) { Ci[fill[b]++] = a; Ci[fill[a]++] = b; }
+        if (a == b) continue;
+        if (Cx) { Cx[fill[b]] = A[k]; Cx[fill[a]] = A[k]; }
+        Ci[fill[b]++] = a;
+        Ci[fill[a]++] = b;
     }
 }
 
-/* For every zero-diagonal node (a constraint row), a neighbour of its own to be eliminated before it (match[u], or
- * -1 if none is left): a variable with a nonzero diagonal that no other constraint row is given and that is not a
+/* For every zero-diagonal node (a constraint row), a neighbour of its own to be eliminated before it (match[u],
+ * left at -1, as the caller set it, if none is left): a variable with a nonzero diagonal that no other constraint row is given and that is not a
  * dense column (more than n / 10 neighbours: the design joints, which AMD puts last). Greedy, the rows with the
  * fewest candidates first; each takes the candidate with the fewest constraint-row neighbours (a slack, whose only
  * one is its own row, before a joint), then the largest |a_uv| of the matrix given. Cp, Ci, Cx: both triangles'
@@ -121,11 +126,9 @@ static int own_neighbours(int n, const int *Cp, const int *Ci, const double *Cx,
         free(zn); free(rows); free(count); free(bucket); free(taken);
         return -1;
     }
-    for (j = 0; j < n; j++) {
-        match[j] = -1;
+    for (j = 0; j < n; j++)
         for (q = Cp[j]; q < Cp[j + 1]; q++)
             if (zero[Ci[q]]) zn[j]++;
-    }
     for (j = 0; j < n; j++) { /* each row's candidates, counted; then the rows by that count (a stable counting sort) */
         if (!zero[j]) continue;
         for (q = Cp[j]; q < Cp[j + 1]; q++)
@@ -174,16 +177,10 @@ static int defer_zero_pivots(int n, int nz, const int *IRN, const int *ICN, cons
         if (IRN[k] == ICN[k]) diag[IRN[k] - 1] += A[k];
     /* zero, or as good as zero: a regularised constraint row's -delta_c (1e-8 mu^0.25) is no pivot to divide by */
     for (j = 0; j < n; j++) zero[j] = fabs(diag[j]) <= WEAK;
-    adjacency(n, nz, IRN, ICN, Cp, Ci, fill);
-    memcpy(fill, Cp, sizeof(int) * (n + 1)); /* the values, into the slots adjacency() filled, in the same order */
-    for (k = 0; k < nz; k++) {
-        int a = IRN[k] - 1, b = ICN[k] - 1;
-        if (a != b) { Cx[fill[b]++] = A[k]; Cx[fill[a]++] = A[k]; }
-    }
+    adjacency(n, nz, IRN, ICN, A, Cp, Ci, n >= MATCHED_FROM ? Cx : NULL, fill); /* values only to match with */
+    for (j = 0; j < n; j++) match[j] = -1;
     if (n >= MATCHED_FROM) {
         if (own_neighbours(n, Cp, Ci, Cx, zero, match) < 0) goto out;
-    } else {
-        for (j = 0; j < n; j++) match[j] = -1;
     }
     for (j = 0; j < n; j++) {
         int top = 0;
@@ -259,7 +256,7 @@ static void ma27a(int *N, int *NZ, const int *IRN, const int *ICN, int *IKEEP, i
     int *Cp = (int *)calloc(n + 1, sizeof(int)), *Ci = (int *)malloc(sizeof(int) * (2 * nz + 1));
     int *fill = (int *)malloc(sizeof(int) * (n + 1));
     if (!Cp || !Ci || !fill) { free(Cp); free(Ci); free(fill); INFO[0] = -1; return; }
-    adjacency(n, nz, IRN, ICN, Cp, Ci, fill);
+    adjacency(n, nz, IRN, ICN, NULL, Cp, Ci, NULL, fill);
     amd_defaults(control);
     status = amd_order(n, Cp, Ci, P, control, info);
     free(Cp); free(Ci); free(fill);
