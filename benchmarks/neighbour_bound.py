@@ -70,15 +70,12 @@ def trace(run: Path, out: Path) -> None:
     print(f"{len(traces)} starts traced into {copy / 'bound_traces.json'}")
 
 
-def stop_at(points, after: int, factor: float) -> int | None:
-    """The iteration a rule (``after``, ``factor``) or the bound in force stops a start at, whichever is first."""
+def first_stop(points, after: int, factor: float) -> int | None:
+    """The first observed iteration at which a rule (``after``, ``factor``) stops a start with these trace points:
+    past ``after`` iterations, feasible and above ``factor`` times its structure's best objective (the bound logged
+    is `BOUND_FACTOR` times it). None: never."""
     own = points[0][3] / BOUND_FACTOR
-
-    def first(k, f):
-        return next((it for it, obj, v, _ in points if it >= k and v <= FEASIBLE and obj > f * own), None)
-
-    hits = [it for it in (first(after, factor), first(BOUND_AFTER, BOUND_FACTOR)) if it is not None]
-    return min(hits) if hits else None
+    return next((it for it, obj, v, _ in points if it >= after and v <= FEASIBLE and obj > factor * own), None)
 
 
 def rules(copy: Path, afters: list[int], factors: list[float]) -> None:
@@ -98,8 +95,8 @@ def rules(copy: Path, afters: list[int], factors: list[float]) -> None:
                 points = traces.get(key)
                 if not points or r.iterations <= 0:
                     continue
-                now, rule = stop_at(points, BOUND_AFTER, BOUND_FACTOR), stop_at(points, after, factor)
-                if rule is None or (now is not None and now <= rule):
+                now, rule = first_stop(points, BOUND_AFTER, BOUND_FACTOR), first_stop(points, after, factor)
+                if rule is None or (now is not None and now <= rule):  # the bound in force stops it as soon
                     continue
                 stopped.add((r.stage, r.structure, r.seed))
                 saved += r.solve_time_s * max(0, r.iterations - rule) / r.iterations
