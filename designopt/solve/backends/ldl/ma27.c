@@ -34,7 +34,7 @@
 #define HDR 2 /* IW's header: nnzA, nnzL */
 #define RECORD 6 /* IKEEP's entries after P and Pinv that this uses: n >= RECORD keeps them */
 #define WEAK 1e-7 /* a diagonal entry this small counts as zero for the ordering (IPOPT's delta_c <= 1e-8) */
-#define MATCHED_FROM 1000 /* from this many rows, a constraint row waits for a neighbour of its own (defer_zero_pivots) */
+#define MATCHED_FROM 1000 /* from this many rows a constraint row waits for its own neighbour (defer_zero_pivots) */
 
 static int ints_needed(int n, int nz, int nnzA, int nnzL) {
     return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + 3 * n + n + nz + (2 * nz + 2 * n);
@@ -112,11 +112,11 @@ static void adjacency(int n, int nz, const int *IRN, const int *ICN, const doubl
 }
 
 /* For every zero-diagonal node (a constraint row), a neighbour of its own to be eliminated before it (match[u],
- * left at -1, as the caller set it, if none is left): a variable with a nonzero diagonal that no other constraint row is given and that is not a
- * dense column (more than n / 10 neighbours: the design joints, which AMD puts last). Greedy, the rows with the
- * fewest candidates first; each takes the candidate with the fewest constraint-row neighbours (a slack, whose only
- * one is its own row, before a joint), then the largest |a_uv| of the matrix given. Cp, Ci, Cx: both triangles'
- * off-diagonal pattern and values. Returns 0, or -1 when out of memory. */
+ * left at -1, as the caller set it, if none is left): a variable with a nonzero diagonal that no other constraint
+ * row is given and that is not a dense column (more than n / 10 neighbours: the design joints, which AMD puts
+ * last). Greedy, the rows with the fewest candidates first; each takes the candidate with the fewest constraint-row
+ * neighbours (a slack, whose only one is its own row, before a joint), then the largest |a_uv| of the matrix given.
+ * Cp, Ci, Cx: both triangles' off-diagonal pattern and values. Returns 0, or -1 when out of memory. */
 static int own_neighbours(int n, const int *Cp, const int *Ci, const double *Cx, const char *zero, int *match) {
     int j, q, r, nrows = 0, dense = n / 10;
     int *zn = (int *)calloc(n, sizeof(int)), *rows = (int *)malloc(sizeof(int) * (n + 1));
