@@ -115,6 +115,50 @@ def test_a_new_analysis_builds_its_own_pattern_whatever_its_workspace_holds(tmp_
     np.testing.assert_allclose(second.solve(b), np.linalg.solve(K, b), rtol=1e-8, atol=1e-10)
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_a_factorisation_with_more_negative_pivots_than_ipopt_solved_with_stops_at_one_more(seed):
+    """Once a factorisation has been solved with (IPOPT accepted its inertia: one negative pivot per constraint),
+    a later one of the same analysis with more negative eigenvalues stops at one negative pivot more than that and
+    reports it: the wrong inertia of the same kind (too many) that the full count, numpy's, would have reported.
+    Solving with a stopped factorisation finishes it first: the same solution, to the bit, as a new analysis that
+    factorised the matrix in full. A matrix with the accepted inertia is then factorised in full again."""
+    rng = np.random.default_rng(200 + seed)
+    K, rows, cols = random_kkt(rng, n_x=30, n_c=12, delta_c=1e-8, definite=True)
+    solver = Ma27(K.shape[0], rows, cols)
+    assert solver.factorise(K[rows, cols])[14] == 12
+    b = rng.normal(size=K.shape[0])
+    solver.solve(b)  # accepted: 12 negative pivots
+    indefinite = K - np.diag(np.r_[np.full(30, 2.0 * np.abs(np.diag(K)[:30]).max()), np.zeros(12)])
+    expected = int(np.sum(np.linalg.eigvalsh(indefinite) < 0))
+    assert expected > 13
+    info = solver.factorise(indefinite[rows, cols])
+    assert info[0] == 0 and info[14] == 13
+    full = Ma27(K.shape[0], rows, cols)
+    full_info = full.factorise(indefinite[rows, cols])
+    assert full_info[0] == 0 and full_info[14] == expected
+    np.testing.assert_array_equal(solver.solve(b), full.solve(b))
+    again = K + np.diag(np.r_[rng.uniform(0, 2, 30), np.zeros(12)])
+    assert solver.factorise(again[rows, cols])[14] == 12
+    x, expected_x = solver.solve(b), np.linalg.solve(again, b)
+    assert np.linalg.norm(x - expected_x) <= 1e-8 * max(1.0, np.linalg.norm(expected_x))
+
+
+def test_a_vanished_constraint_row_is_reported_singular_not_stopped():
+    """A constraint row whose values are all zero has a zero pivot whatever the order: the factorisation must reach
+    it and report the matrix singular (which IPOPT answers by regularising the constraint block), even when the
+    matrix also has more negative pivots than the last one solved with (which IPOPT answers by perturbing the
+    Hessian block)."""
+    rng = np.random.default_rng(9)
+    K, rows, cols = random_kkt(rng, n_x=30, n_c=12, delta_c=0.0, definite=True)
+    K[-1, -1] = -1e-8
+    solver = Ma27(K.shape[0], rows, cols)
+    assert solver.factorise(K[rows, cols])[14] == 12
+    solver.solve(rng.normal(size=K.shape[0]))
+    vanished = K - np.diag(np.r_[np.full(30, 2.0 * np.abs(np.diag(K)[:30]).max()), np.zeros(12)])
+    vanished[-1, :] = vanished[:, -1] = 0.0
+    assert solver.factorise(vanished[rows, cols])[0] == -5
+
+
 def test_a_singular_matrix_is_reported_singular():
     """A constraint row with no variable (a zero row and column): the zero pivot is reported as MA27's
     singular-matrix flag, which IPOPT answers by regularising the constraint block."""

@@ -11,18 +11,32 @@
  * whose sizes ma27ad asks for through INFO(5) and INFO(6). Layouts:
  *   IKEEP: P[n] (new -> old), Pinv[n] (old -> new), then (n >= RECORD) nnzA, nnzL, whether reordered, and the
  *          workspace the pattern was built in: IW's address (two ints) and LIW
- *   IW: nnzA nnzL | Ap[n+1] Ai[nnzA] (the permuted upper triangle, every diagonal present) | Lp[n+1] Li[nnzL] |
- *       etree[n] Lnz[n] | iwork[3n] (QDLDL's; after a factorisation its first n hold P for ma27cd) |
- *       bwork[n] (QDLDL's; after a factorisation bwork[0] holds the offset of Lx in A) | map[nz] (triplet ->
- *       Ai slot) | scratch for building the pattern [2 nz + 2 n]
+ *   IW: nnzA nnzL nz accepted last | Ap[n+1] Ai[nnzA] (the permuted upper triangle, every diagonal present) |
+ *       Lp[n+1] Li[nnzL] | etree[n] Lnz[n] | perm[n] (P, for ma27cd) | iwork[3n] (QDLDL's) | bwork[n] (QDLDL's) |
+ *       map[nz] (triplet -> Ai slot) | scratch for building the pattern [2 nz + 2 n]
  *   A: the triplets' values[nz] (written by IPOPT) | Ax[nnzA] | Lx[nnzL] | D[n] | Dinv[n] | fwork[n] | x[n]
  * The pattern of IW is built at the first factorisation of an analysis and reused by the next ones, so a
  * factorisation is a scatter of the values and QDLDL's numeric pass. Whether IW holds this analysis's pattern is
  * recorded in IKEEP (IW's address and LIW when it was built), never read from IW itself: IPOPT allocates IW
  * anew for each analysis and does not clear it, so it may hold what an earlier analysis left there (a header that
  * matched and a stale map once scattered out of bounds: a screen solve's segfault, docs/decisions.md). IW's header
- * (nnzA, nnzL) is for ma27cd, which is given IW but not IKEEP. Systems with n < RECORD are analysed anew
+ * (nnzA, nnzL, nz) is for ma27cd, which is given IW but not IKEEP. Systems with n < RECORD are analysed anew
  * at every factorisation.
+ *
+ * A factorisation stops once it has more negative pivots than the last one IPOPT solved with (`accepted`, learnt
+ * at ma27cd; -1 until then). IPOPT wants the same inertia at every factorisation of an analysis (one negative
+ * eigenvalue per constraint), and the pivots so far are the inertia of a leading block, whose negative eigenvalues
+ * cannot outnumber the whole matrix's (Cauchy interlacing): such a matrix has the wrong inertia whatever its other
+ * pivots. It is reported with one negative pivot more than accepted (INFO(15)), the branch the full count takes
+ * (too many, not too few), and IPOPT perturbs and factorises again as before. On the exploration problem 127 of a
+ * solve's 232 factorisations have too many, the stop comes after two thirds of the work on median, and the
+ * iteration costs 0.96x (docs/decisions.md, 2026-11-28). Not stopped: a matrix with a node whose row and column
+ * are zero (a constraint row whose Jacobian row vanished), whose zero pivot the full factorisation reports as
+ * singular, which IPOPT answers otherwise. A pivot that cancels to exactly zero after the stop is reported as too
+ * many negative pivots instead: no solve of 960 exploration starts and 9 default runs changed, 2 of 12 main-job
+ * starts to the iteration cap with every system by this library did. `last` is the negative pivots of the last
+ * factorisation, -1 for a singular one, STOPPED for one stopped: IPOPT solves only with a factorisation whose
+ * inertia it accepted, but should it solve with a stopped one, ma27cd finishes it first.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -31,13 +45,16 @@
 #include "amd.h"
 #include "qdldl.h"
 
-#define HDR 2 /* IW's header: nnzA, nnzL */
+#define HDR 5 /* IW's header: nnzA, nnzL, nz, accepted, last */
+#define ACCEPTED 3 /* IW's slot: negative pivots of the last factorisation solved with (-1: none yet) */
+#define LAST 4 /* IW's slot: negative pivots of the last factorisation (-1: singular; STOPPED) */
+#define STOPPED (-2)
 #define RECORD 6 /* IKEEP's entries after P and Pinv that this uses: n >= RECORD keeps them */
 #define WEAK 1e-7 /* a diagonal entry this small counts as zero for the ordering (IPOPT's delta_c <= 1e-8) */
 #define MATCHED_FROM 1000 /* from this many rows a constraint row waits for its own neighbour (defer_zero_pivots) */
 
 static int ints_needed(int n, int nz, int nnzA, int nnzL) {
-    return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + 3 * n + n + nz + (2 * nz + 2 * n);
+    return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + n + 3 * n + n + nz + (2 * nz + 2 * n);
 }
 
 static int doubles_needed(int n, int nz, int nnzA, int nnzL) { return nz + nnzA + nnzL + 4 * n; }
@@ -300,33 +317,49 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
     if (*LIW < ineed) { INFO[0] = -3; INFO[1] = ineed; return; }
     if (*LA < dneed) { INFO[0] = -4; INFO[1] = dneed; return; }
     int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
-    int *Lnz = etree + n, *iwork = Lnz + n, *bwork = iwork + 3 * n, *map = bwork + n;
+    int *Lnz = etree + n, *perm = Lnz + n, *iwork = perm + n, *bwork = iwork + 3 * n, *map = bwork + n;
     int *scratch = map + nz; /* 2 nz + 2 n */
     if (!(record && built_in(record, IW, *LIW))) {
         if (pattern(n, nz, IRN, ICN, Pinv, Ap, scratch, map) != nnzA) { INFO[0] = -1; return; }
         memcpy(Ai, scratch, sizeof(int) * nnzA);
         if (QDLDL_etree(n, Ap, Ai, iwork, Lnz, etree) != nnzL) { INFO[0] = -1; return; }
         IW[0] = nnzA; IW[1] = nnzL;
+        IW[ACCEPTED] = -1; /* nothing solved with yet in this analysis */
         if (record) record_workspace(record, IW, *LIW);
     }
+    IW[2] = nz;
+    memcpy(perm, IKEEP, sizeof(int) * n); /* for ma27cd, which is not given IKEEP */
     double *Ax = A + nz, *Lx = Ax + nnzA, *D = Lx + nnzL, *Dinv = D + n, *fwork = Dinv + n;
     memset(Ax, 0, sizeof(double) * nnzA);
     for (k = 0; k < nz; k++) Ax[map[k]] += A[k];
-    pos = QDLDL_factor(n, Ap, Ai, Ax, Lp, Li, Lx, D, Dinv, Lnz, etree, bwork, iwork, fwork);
-    if (pos < 0) { INFO[0] = -5; INFO[1] = n - 1; return; }
-    INFO[14] = n - pos; /* negative eigenvalues: the negative entries of D */
+    int limit = IW[ACCEPTED], j, p;
+    if (limit >= 0) { /* a node whose row and column are zero here has a zero pivot: the factorisation must find it */
+        memset(bwork, 0, sizeof(int) * n); /* QDLDL sets bwork up again */
+        for (j = 0; j < n; j++)
+            for (p = Ap[j]; p < Ap[j + 1]; p++)
+                if (Ax[p] != 0.0) bwork[j] = bwork[Ai[p]] = 1;
+        for (j = 0; j < n && limit >= 0; j++)
+            if (!bwork[j]) limit = -1;
+    }
+    pos = QDLDL_factor(n, Ap, Ai, Ax, Lp, Li, Lx, D, Dinv, Lnz, etree, bwork, iwork, fwork, limit);
     INFO[8] = nnzL;
     INFO[9] = nnzL;
-    memcpy(iwork, IKEEP, sizeof(int) * n); /* for ma27cd, which is not given IKEEP */
-    bwork[0] = nz + nnzA;                  /* where Lx starts in A */
+    if (pos == -1) { INFO[0] = -5; INFO[1] = n - 1; IW[LAST] = -1; return; }
+    IW[LAST] = pos == STOPPED ? STOPPED : n - pos;
+    INFO[14] = pos == STOPPED ? limit + 1 : n - pos; /* negative eigenvalues: the negative entries of D */
 }
 
 static void ma27c(int *N, double *A, int *IW, double *RHS) {
     int n = *N, i;
-    int nnzA = IW[0], nnzL = IW[1];
+    int nnzA = IW[0], nnzL = IW[1], nz = IW[2];
     int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
-    int *Lnz = etree + n, *P = Lnz + n, *bwork = P + 3 * n;
-    double *Lx = A + bwork[0], *Dinv = Lx + nnzL + n, *x = Dinv + 2 * n;
+    int *Lnz = etree + n, *P = Lnz + n, *iwork = P + n, *bwork = iwork + 3 * n;
+    double *Ax = A + nz, *Lx = Ax + nnzA, *D = Lx + nnzL, *Dinv = D + n, *fwork = Dinv + n, *x = fwork + n;
+    if (IW[LAST] == STOPPED) { /* solved with although stopped early: finish it */
+        int pos = QDLDL_factor(n, Ap, Ai, Ax, Lp, Li, Lx, D, Dinv, Lnz, etree, bwork, iwork, fwork, -1);
+        IW[LAST] = pos >= 0 ? n - pos : -1;
+    }
+    if (IW[LAST] >= 0) IW[ACCEPTED] = IW[LAST];
     for (i = 0; i < n; i++) x[i] = RHS[P[i]];
     QDLDL_solve(n, Lp, Li, Lx, Dinv, x);
     for (i = 0; i < n; i++) RHS[P[i]] = x[i];

@@ -20,6 +20,9 @@
  *
  * SPDX-License-Identifier: Apache-2.0
  * SPDX-ExternalRef: PACKAGE_MANAGER purl pkg:github/osqp/qdldl
+ *
+ * Changed by designopt (2026-11-28): QDLDL_factor's last argument, maxNegative, stops the factorisation once
+ * D has more negative entries than that (return value -2).
  */
 #include "qdldl.h"
 
@@ -95,7 +98,7 @@ QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* 
                        const QDLDL_float* Ax, QDLDL_int* Lp, QDLDL_int* Li, QDLDL_float* Lx,
                        QDLDL_float* D, QDLDL_float* Dinv, const QDLDL_int* Lnz,
                        const QDLDL_int* etree, QDLDL_bool* bwork, QDLDL_int* iwork,
-                       QDLDL_float* fwork) {
+                       QDLDL_float* fwork, const QDLDL_int maxNegative) {
     QDLDL_int    i = 0;
     QDLDL_int    j = 0;
     QDLDL_int    k = 0;
@@ -112,6 +115,7 @@ QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* 
     QDLDL_float  yVals_cidx = 0.0;
     QDLDL_bool*  yMarkers;
     QDLDL_int    positiveValuesInD = 0;
+    QDLDL_int    negativeValuesInD = 0;
 
     // Partition working memory into pieces
     yMarkers = bwork;
@@ -145,6 +149,8 @@ QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* 
 
     if(D[0] > 0.0) {
         positiveValuesInD++;
+    } else if(++negativeValuesInD > maxNegative && maxNegative >= 0) {
+        return -2;
     }
     Dinv[0] = 1 / D[0];
 
@@ -251,6 +257,8 @@ QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* 
 
         if(D[k] > 0.0) {
             positiveValuesInD++;
+        } else if(++negativeValuesInD > maxNegative && maxNegative >= 0) {
+            return -2;
         }
 
         // Compute the inverse of the diagonal

@@ -20,6 +20,9 @@
  *
  * SPDX-License-Identifier: Apache-2.0
  * SPDX-ExternalRef: PACKAGE_MANAGER purl pkg:github/osqp/qdldl
+ *
+ * Changed by designopt (2026-11-28): QDLDL_factor's last argument, maxNegative, stops the factorisation once
+ * D has more negative entries than that (return value -2).
  */
 #ifndef QDLDL_H
 #define QDLDL_H
@@ -122,17 +125,20 @@ QDLDL_API QDLDL_int QDLDL_etree(const QDLDL_int n, const QDLDL_int* Ap, const QD
  * @param  bwork  working array of bools. Length is n
  * @param  iwork  working array of integers. Length is 3*n
  * @param  fwork  working array of floats. Length is n
+ * @param  maxNegative  (added by designopt) stop once D has more negative
+ *                elements than this; -1: never stop
  * @return        Returns a count of the number of positive elements
  *                in D.  Returns -1 and exits immediately if any element
  *                of D evaluates exactly to zero (matrix is not quasidefinite
- *                or otherwise LDL factorisable)
+ *                or otherwise LDL factorisable); returns -2 (designopt) when
+ *                stopped by maxNegative, the factors then incomplete
  *
  */
 QDLDL_API QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* Ai,
                                  const QDLDL_float* Ax, QDLDL_int* Lp, QDLDL_int* Li,
                                  QDLDL_float* Lx, QDLDL_float* D, QDLDL_float* Dinv,
                                  const QDLDL_int* Lnz, const QDLDL_int* etree, QDLDL_bool* bwork,
-                                 QDLDL_int* iwork, QDLDL_float* fwork);
+                                 QDLDL_int* iwork, QDLDL_float* fwork, const QDLDL_int maxNegative);
 
 
 /**
