@@ -156,8 +156,13 @@ PRESETS: dict[str, Search] = {
     # the sweep's solver time) lowered 8 and 7 structure bests by more than 1 % (up to 0.73x), none higher. The best 4
     # distinct coarse optima refined, not 2: on seeds 2101-2103 (replays from the refine on), references within 1.10x
     # 6 -> 6, 5 -> 7, 3 -> 4 of 10; structure bests lower / higher by > 1 % 22 / 2, 21 / 6, 15 / 8; at 1.20x, 1.17x
-    # and 1.09x the solver time (docs/benchmarks.md, "Sweep")
-    "quick": Search(starts=40, rebranch=0, refine=4, reflect=3,
+    # and 1.09x the solver time (docs/benchmarks.md, "Sweep"). The 4 chosen by a screen: the best 12 distinct coarse
+    # optima lifted to 20 waypoints and ranked there (RRPR's best coarse optimum, 0.0152 on 10 waypoints, ends at
+    # 0.13-0.14 on the full path on seeds 2114-2116, where others end at 0.024): on fresh seeds 2118 and 2119 (replays
+    # from the screen on), structure bests lower / higher by > 1 % 27 / 16 and 35 / 17 of 124 (geometric mean 0.97x
+    # both), references within 1.10x 7 -> 7 and 6 -> 6, at 1.24x and 1.15x the solver time after the exploration
+    # (docs/decisions.md)
+    "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
     # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against
