@@ -34,10 +34,10 @@ BASE_OPTIONS = {"ipopt.print_level": 0, "ipopt.sb": "yes", "print_time": False, 
 WARM_OPTIONS = {"ipopt.mu_init": 1e-4, "ipopt.bound_push": 1e-6, "ipopt.bound_frac": 1e-6}
 # IPOPT stops these before its first iteration, and the iteration count it reports is then stale.
 PRE_ITERATION_STATUSES = {"Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition", "Invalid_Option"}
-# Iterations between two calls of the observers: each call is a Python callback (then copying every output of the
-# solver); calling it every iteration cost 10 % of an exploration solve (1.70 -> 1.54 ms/iter, 24 starts,
-# benchmarks/speed_table.py --only "exploration (10 wp)"), and a watch with a patience of 30 iterations loses
-# nothing by looking every 5th.
+# Iterations between two calls of the observers: each call is a Python callback (until 2026-11-28 one that copied
+# every output of the solver); calling it every iteration cost 10 % of an exploration solve (1.70 -> 1.54 ms/iter,
+# 24 starts, benchmarks/speed_table.py --only "exploration (10 wp)"), and a watch with a patience of 30 iterations
+# loses nothing by looking every 5th.
 OBSERVE_EVERY = 5
 
 

@@ -33,7 +33,7 @@
  * iteration costs 0.96x (docs/decisions.md, 2026-11-28). Not stopped: a matrix with a node whose row and column
  * are zero (a constraint row whose Jacobian row vanished), whose zero pivot the full factorisation reports as
  * singular, which IPOPT answers otherwise. A pivot that cancels to exactly zero after the stop is reported as too
- * many negative pivots instead: no solve of 960 exploration starts and 9 default runs changed, 2 of 12 main-job
+ * many negative pivots instead: no solve of 1,920 exploration starts and 9 default runs changed, 2 of 12 main-job
  * starts to the iteration cap with every system by this library did. `last` is the negative pivots of the last
  * factorisation, -1 for a singular one, STOPPED for one stopped: IPOPT solves only with a factorisation whose
  * inertia it accepted, but should it solve with a stopped one, ma27cd finishes it first.
