@@ -115,6 +115,12 @@ def test_a_new_analysis_builds_its_own_pattern_whatever_its_workspace_holds(tmp_
     np.testing.assert_allclose(second.solve(b), np.linalg.solve(K, b), rtol=1e-8, atol=1e-10)
 
 
+def _hessian_block_made_negative(K: np.ndarray, n_x: int) -> np.ndarray:
+    """K with twice its largest Hessian diagonal entry taken off every Hessian diagonal entry: many more negative
+    eigenvalues than constraints."""
+    return K - np.diag(np.r_[np.full(n_x, 2.0 * np.abs(np.diag(K)[:n_x]).max()), np.zeros(K.shape[0] - n_x)])
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_a_factorisation_with_more_negative_pivots_than_ipopt_solved_with_stops_at_one_more(seed):
     """Once a factorisation has been solved with (IPOPT accepted its inertia: one negative pivot per constraint),
@@ -128,7 +134,7 @@ def test_a_factorisation_with_more_negative_pivots_than_ipopt_solved_with_stops_
     assert solver.factorise(K[rows, cols])[14] == 12
     b = rng.normal(size=K.shape[0])
     solver.solve(b)  # accepted: 12 negative pivots
-    indefinite = K - np.diag(np.r_[np.full(30, 2.0 * np.abs(np.diag(K)[:30]).max()), np.zeros(12)])
+    indefinite = _hessian_block_made_negative(K, 30)
     expected = int(np.sum(np.linalg.eigvalsh(indefinite) < 0))
     assert expected > 13
     info = solver.factorise(indefinite[rows, cols])
@@ -154,7 +160,7 @@ def test_a_vanished_constraint_row_is_reported_singular_not_stopped():
     solver = Ma27(K.shape[0], rows, cols)
     assert solver.factorise(K[rows, cols])[14] == 12
     solver.solve(rng.normal(size=K.shape[0]))
-    vanished = K - np.diag(np.r_[np.full(30, 2.0 * np.abs(np.diag(K)[:30]).max()), np.zeros(12)])
+    vanished = _hessian_block_made_negative(K, 30)
     vanished[-1, :] = vanished[:, -1] = 0.0
     assert solver.factorise(vanished[rows, cols])[0] == -5
 
