@@ -77,7 +77,8 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert "drawn from the task's box" in boxed.describe() and "box" not in PRESETS["default"].describe()
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4,
-                                             reflect=3, seed=2, profile=PRESETS["quick"].profile)
+                                             reflect=3, seed=2, explore_linear_solver="ldl",
+                                             profile=PRESETS["quick"].profile)
 
 
 def test_a_profiles_options_reach_ipopt_and_the_production_preset_regularises():

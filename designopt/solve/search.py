@@ -161,8 +161,12 @@ PRESETS: dict[str, Search] = {
     # 0.13-0.14 on the full path on seeds 2114-2116, where others end at 0.024): on fresh seeds 2118 and 2119 (replays
     # from the screen on), structure bests lower / higher by > 1 % 27 / 16 and 35 / 17 of 124 (geometric mean 0.97x
     # both), references within 1.10x 7 -> 7 and 6 -> 6, at 1.24x and 1.15x the solver time after the exploration
-    # (docs/decisions.md)
+    # (docs/decisions.md). The exploration's KKT systems by the LDLᵀ, as in the default: on fresh seeds 2123 and
+    # 2124 (whole sweeps against main's), exploration solver time 0.60x and 0.59x, the sweep's wall 0.79x and 0.80x,
+    # structure bests lower / higher by > 1 % 32 / 20 and 25 / 27, references within 1.10x 3 -> 4 and 5 -> 4
+    # (docs/decisions.md, "Speed")
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3,
+                    explore_linear_solver="ldl",
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
     # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against
