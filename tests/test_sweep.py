@@ -118,6 +118,8 @@ def test_a_structure_grows_from_a_shorter_one_only_when_that_found_a_cheaper_des
     # RRRP is RRP with a joint inserted at 0, 1 or 2 (and RRR, absent, at 3); RRP has no shorter neighbour here
     assert [t.start.where for t in tasks] == grown
     assert all(isinstance(t.start, Grown) and t.problem.chain.structure == "RRRP" and t.profile.warm for t in tasks)
+    # a grown start keeps the preset's cap: only the cold same-length starts are capped sooner
+    assert all(t.profile.max_iter == preset("quick").profile.max_iter > neighbour_stage.SAME_LENGTH_CAP for t in tasks)
     assert len({t.start.number for t in tasks}) == len(tasks)
     # each is held to its structure's best: stopped if still above 3x its objective (1.5 * 2.0) after 300 iterations
     assert all(t.bound == Bound(pytest.approx(3 * 1.5 * 2.0), 300) and "above_bound" in t.profile.observers
@@ -207,7 +209,7 @@ def test_a_second_pass_starts_only_from_the_structures_the_first_pass_lowered():
     structure the first pass lowered, and nothing else (RPP is not RRR's neighbour); then the step ends."""
     from types import SimpleNamespace
 
-    from designopt.solve import Job, Searched, preset
+    from designopt.solve import Job, Searched, Seeded, preset
     from designopt.solve.strategies import neighbours as neighbour_stage
 
     def solution(structure, cost):
@@ -219,6 +221,9 @@ def test_a_second_pass_starts_only_from_the_structures_the_first_pass_lowered():
     plan = neighbour_stage.plan(searched, preset("quick"))
     first = next(plan)
     assert sorted((t.problem.chain.structure, t.stage) for t in first) == [("RPP", "neighbour"), ("RRR", "neighbour")]
+    # same-length starts: cold, from the neighbour's design, at most SAME_LENGTH_CAP iterations (the preset: 600)
+    cap = neighbour_stage.SAME_LENGTH_CAP
+    assert all(isinstance(t.start, Seeded) and not t.profile.warm and t.profile.max_iter == cap for t in first)
     landed = {"RRR": 1.0, "RPP": 6.0}
     second = plan.send([(t, solution(t.problem.chain.structure, landed[t.problem.chain.structure])) for t in first])
     assert [(t.problem.chain.structure, t.stage) for t in second] == [("RRP", "neighbour2")]

@@ -1,18 +1,18 @@
 """Neighbour starts: one more start per problem from each neighbouring structure that found a better design.
 
-Two problems of one search are neighbours when they share their case and their structures are one edit apart:
-one joint's type differs (R <-> P), or one has a joint the other lacks. A structure whose neighbour found a cheaper
-design was stuck in a worse basin, and the neighbour's design is a good guess for it: a structure of the same
-length starts from its placement and every link parameter of the same name (`Seeded` with that design, joints by
-IK); a structure with one joint fewer is this one with a link held as an identity transform, so its solution, the
-link inserted, is a start that already tracks the path (`Grown`, solved warm); and a structure with one joint more
-inserted first whose first joint stays still along the path is this one placed by that link's transform, so its
-solution without the link is an exact start too (`Pruned`, solved warm). The starts are solved on the full
-path (stage ``neighbour``) and join each problem's final solves; a second pass (``neighbour2``) gives starts from the
-structures whose best the first lowered, so that a design found there reaches the structures next to it (up to
-``PASSES`` passes). A start that is still above ``BOUND_FACTOR`` times its
-structure's best objective after ``BOUND_AFTER`` iterations is stopped there (`designopt.solve.observers.AboveBound`).
-Problems without neighbours (every search of a single structure) get no task.
+Two problems of one search are neighbours when they share their case and their structures are one edit apart: one
+joint's type differs (R <-> P), or one has a joint the other lacks. A structure whose neighbour found a cheaper
+design was stuck in a worse basin, and the neighbour's design is a good guess for it: a structure of the same length
+starts from its placement and every link parameter of the same name (`Seeded` with that design, joints by IK, at
+most ``SAME_LENGTH_CAP`` iterations); a structure with one joint fewer is this one with a link held as an identity
+transform, so its solution, the link inserted, is a start that already tracks the path (`Grown`, solved warm); and a
+structure with one joint more inserted first whose first joint stays still along the path is this one placed by that
+link's transform, so its solution without the link is an exact start too (`Pruned`, solved warm). The starts are
+solved on the full path (stage ``neighbour``) and join each problem's final solves; a second pass (``neighbour2``)
+gives starts from the structures whose best the first lowered, so that a design found there reaches the structures
+next to it (up to ``PASSES`` passes). A start that is still above ``BOUND_FACTOR`` times its structure's best
+objective after ``BOUND_AFTER`` iterations is stopped there (`designopt.solve.observers.AboveBound`). Problems
+without neighbours (every search of a single structure) get no task.
 """
 
 from __future__ import annotations
@@ -42,6 +42,13 @@ PRUNED_FROM = 50
 # more than 1 % (RRR reaching its reference through PRRR's pruned design; PPRPRR 0.45x), none higher
 # (docs/benchmarks.md, "Sweep")
 PASSES = 2
+# A cold same-length start is capped at SAME_LENGTH_CAP iterations (before the bound's BOUND_AFTER, which so holds
+# only the grown and pruned starts). Of the 960 such starts of the K = I sweeps 2122-2124 (1,046 s of solver time),
+# the 28 that beat their structure's refined best by > 1 % took 35-427 iterations, 25 of them at most 200. Judged on
+# fresh seeds 2126 and 2127 (the neighbour and later stages replayed side by side): their solver time 0.70x and
+# 0.72x, references within 1.10x 5 + 3 either way, 2 and 0 structure bests higher by > 1 % (RRP 1.14x), none lower
+# (docs/decisions.md, "Speed").
+SAME_LENGTH_CAP = 200
 
 
 def neighbours(structure: str, structures: list[str]) -> list[str]:
@@ -107,8 +114,9 @@ def _starts(searched, search, stage: str, lowered) -> list[Task]:
         job, own, structure = s.job, s.best[1], s.job.problem.chain.structure
         same_case = [st for case, st in best if case == job.case]
         same_length, starts = neighbours(structure, same_case), []
-        # same-length starts are solved cold (joints by IK); grown and pruned ones already track the path: warm
-        cold, warm = solve_setup(job, search), solve_setup(job, search, search.profile.warmed())
+        # same-length starts are solved cold (joints by IK), capped; grown and pruned ones already track the path: warm
+        cold = solve_setup(job, search, search.profile.capped(SAME_LENGTH_CAP))
+        warm = solve_setup(job, search, search.profile.warmed())
         for j, other in enumerate(same_length):
             if found := cheaper(job.case, other, own):
                 design = design_from(job.problem, found[0].problem, found[1].raw.q_d)
