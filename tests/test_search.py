@@ -78,7 +78,12 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4,
                                              reflect=3, seed=2, explore_linear_solver="ldl",
-                                             profile=PRESETS["quick"].profile)
+                                             screen_linear_solver="ldl", profile=PRESETS["quick"].profile)
+    # a stage's own linear solver is named in the search's words, the profile's is not
+    quick = PRESETS["quick"].describe()
+    assert "20 waypoints (<= 300 iterations, KKT systems by ldl, if" in quick and quick.count("KKT systems by ldl") == 2
+    assert "re-ranked on 40 waypoints (<= 300 iterations, each from barrier the warm start's and 1e-06, if" in (
+        PRESETS["default"].describe())
 
 
 def test_a_profiles_options_reach_ipopt_and_the_production_preset_regularises():
@@ -508,7 +513,8 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
 
 
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
-    """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter,
+    """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter (and
+    with screen_linear_solver),
     refinement within the profile's max_iter (screen and refine once from each barrier of screen_mu_init and
     refine_mu_init): a screening solve only
     ranks, so a stalling one must not take the full budget (design only stalls there). The caps are read off the
@@ -517,7 +523,8 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     problem = problem_from_config(parse_config(milling_12))
     search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
                     screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),  # rebranch: its own test
-                    explore_linear_solver="ldl", screen_mu_init=(None, 1e-7), refine_mu_init=(None, 1e-6))
+                    explore_linear_solver="ldl", screen_linear_solver="ldl", screen_mu_init=(None, 1e-7),
+                    refine_mu_init=(None, 1e-6))
     done = []
 
     def execute(tasks):
@@ -532,8 +539,8 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
         assert max(s.raw.iterations for t, s in done if t.stage == stage) <= cap
     waypoints = {t.stage: t.problem.toolpath.n for t, _ in done}
     assert waypoints == {"explore": 6, "screen": 9, "screen2": 9, "refine": 12, "refine2": 12}
-    solvers = {t.stage: t.profile.linear_solver for t, _ in done}  # and the exploration its own linear solver
-    assert set(solvers.values()) == {"mumps"} | {"ldl"} and solvers["explore"] == "ldl"
+    solvers = {t.stage: t.profile.linear_solver for t, _ in done}  # the exploration and the screen their own
+    assert solvers == {"explore": "ldl", "screen": "ldl", "screen2": "ldl", "refine": "mumps", "refine2": "mumps"}
     # each candidate screened once per screen barrier (the warm start's own, then 1e-7) and refined once per refine
     # barrier (the warm start's own, then 1e-6)
     barriers = {t.stage: dict(t.profile.options).get("ipopt.mu_init") for t, _ in done}

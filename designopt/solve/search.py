@@ -43,10 +43,11 @@ class Search:
     the design held there (`strategies.continuation`). ``structure_neighbours``: after the strategy, one more
     start per problem from each neighbouring structure's better design (`strategies.neighbours`; problems whose
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
-    solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None:
-    the profile's; `SolverProfile.linear_solver`). ``refine_mu_init``: the barrier parameters the refine's warm
-    solves start from (IPOPT's ``mu_init``; None: the warm start's own, 1e-4, `designopt.solve.backends.ipopt`),
-    each candidate refined once per value (stages ``refine``, ``refine2``, ...; the answer is the best of all): from
+    solver profile; ``explore_linear_solver`` and ``screen_linear_solver``: the exploration's and the screen's
+    linear solver instead of the profile's (None: the profile's; `SolverProfile.linear_solver`).
+    ``refine_mu_init``: the barrier parameters the refine's warm solves start from (IPOPT's ``mu_init``; None: the
+    warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate refined once per value (stages
+    ``refine``, ``refine2``, ...; the answer is the best of all): from
     a small one a refine stays in the basin its screened start is in, from the warm start's it sometimes walks
     into a better one and more often into a worse one. ``screen_mu_init``: the same for the screen (stages
     ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``reflect``: after the
@@ -76,6 +77,7 @@ class Search:
     structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
     explore_linear_solver: str | None = None
+    screen_linear_solver: str | None = None
     screen_mu_init: tuple[float | None, ...] = (None,)
     refine_mu_init: tuple[float | None, ...] = (None,)
     reflect: int = 0
@@ -110,20 +112,25 @@ class Search:
                     f"{solver}")
         capped = f" (at most {self.screen_per_form} of one form)" if self.screen_per_form is not None else ""
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
-                  f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}, if the path has more)"
-                  if self.screen_waypoints else "")
+                  f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
+                  f"{self._kkt(self.screen_linear_solver)}, if the path has more)" if self.screen_waypoints else "")
         per_form = (f" (at most {self.rebranch_per_form} of one form)" if self.rebranch_per_form is not None
                     else "")
         if self.rebranch_new_forms:
             per_form += f" and the best of up to {self.rebranch_new_forms} forms not among them"
         again = (f", the best {self.rebranch} distinct{per_form} restarted {self.rebranch_starts} times each on a "
                  f"new joint branch" if self.rebranch else "")
-        kkt = self.explore_linear_solver or self.profile.linear_solver
-        kkt = f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
+        kkt = self._kkt(self.explore_linear_solver)
         barrier = _barriers(self.refine_mu_init)
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){reflect}{held}{solver}")
+
+
+    def _kkt(self, linear_solver: str | None) -> str:
+        """A stage's linear solver in words, where it is not the profile's."""
+        kkt = linear_solver or self.profile.linear_solver
+        return f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
 
 
 def _barriers(mu_init: tuple[float | None, ...]) -> str:
@@ -164,9 +171,12 @@ PRESETS: dict[str, Search] = {
     # (docs/decisions.md). The exploration's KKT systems by the LDLᵀ, as in the default: on fresh seeds 2123 and
     # 2124 (whole sweeps against main's), exploration solver time 0.60x and 0.59x, the sweep's wall 0.79x and 0.80x,
     # structure bests lower / higher by > 1 % 32 / 20 and 25 / 27, references within 1.10x 3 -> 4 and 5 -> 4
-    # (docs/decisions.md, "Speed")
+    # (docs/decisions.md, "Speed"). The screen's too (20 waypoints, below the LDLᵀ's MATCHED_FROM; the refine's 40
+    # gain nothing): on fresh seeds 2130 and 2131 (replays from the screen on, side by side) the screen's solver time
+    # 0.69x, the replayed stages' 0.894x both, structure bests lower / higher by > 1 % 9 / 12 and 19 / 7, references
+    # within 1.10x 4 -> 4 and 4 -> 5 (docs/decisions.md, "Speed")
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3,
-                    explore_linear_solver="ldl",
+                    explore_linear_solver="ldl", screen_linear_solver="ldl",
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
     # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against

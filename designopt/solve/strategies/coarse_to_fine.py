@@ -41,12 +41,12 @@ def coarse_problem(problem: DesignProblem, waypoints: int) -> DesignProblem:
 
 
 def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, search, max_iter: int | None = None,
-                 mu_init: float | None = None, per_form: int | None = None):
+                 mu_init: float | None = None, per_form: int | None = None, linear_solver: str | None = None):
     """For every job, its ``count`` best distinct solutions (at most ``per_form`` of one form before other forms,
     `optima.distinct_best`; None: by cost alone) lifted to ``waypoints`` (None: the full path), each solved warm
     within ``max_iter`` iterations (None: the profile's own cap), from barrier parameter ``mu_init`` (None: the warm
-    start's own)."""
-    warm = search.profile.warmed().capped(max_iter)
+    start's own), its KKT systems by ``linear_solver`` (None: the profile's)."""
+    warm = search.profile.warmed().capped(max_iter).solved_by(linear_solver)
     if mu_init is not None:
         warm = warm.with_options(**{"ipopt.mu_init": mu_init})
     tasks = []
@@ -110,7 +110,8 @@ def plan(jobs, search):
                  for task in lifted_tasks(sub, [explored[k] for k in screened], search.screen,
                                           numbered_stage("screen", i), search.screen_waypoints, search,
                                           search.screen_max_iter, mu_init=screen_mu,
-                                          per_form=search.screen_per_form)]
+                                          per_form=search.screen_per_form,
+                                          linear_solver=search.screen_linear_solver)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
