@@ -126,7 +126,6 @@ class Search:
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){reflect}{held}{solver}")
 
-
     def _kkt(self, linear_solver: str | None) -> str:
         """A stage's linear solver in words, where it is not the profile's."""
         kkt = linear_solver or self.profile.linear_solver
