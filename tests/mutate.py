@@ -122,7 +122,7 @@ MUTATIONS = [
     Mutation("the reflect stage never runs (Search.reflect ignored)", "designopt/solve/strategies/reflect.py",
              "for i in range(search.reflect):", "for i in range(0):", ("tests/test_reflections.py",)),
     Mutation("the screen's candidates by cost alone (screen_per_form ignored)",
-             "designopt/solve/strategies/coarse_to_fine.py", "per_form=search.screen_per_form)", "per_form=None)",
+             "designopt/solve/strategies/coarse_to_fine.py", "per_form=search.screen_per_form,", "per_form=None,",
              ("tests/test_search.py",)),
     Mutation("an optimum added to the second round whatever its form", "designopt/solve/optima.py",
              "            if f not in seen:", "            if True:", ("tests/test_search.py",)),
