@@ -29,6 +29,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,12 +45,12 @@ FLAGS = ("-fPIC", "-shared", "-ffp-contract=off")
 # machine (the cache), paid back within one solve from some 500 points (a program of 250 waypoints with a cell).
 # Below it, ``tiered``: O0 first, O1 once the block has been solved with long enough to pay for it (module doc).
 AUTO_O1_FROM = 500
-# Seconds of solves with a tiered block after which its -O1 build starts: the solving whose -O0 penalty (about a
-# fifth of it on the main job) adds up to what gcc -O1 takes for the main job's blocks (about 10 s) -- the
-# ski-rental rule, which never costs more than twice what knowing the future would. A sweep's structure is solved
-# for about 15 s and never tiers up; a task run again and again does from its second run.
+# Seconds of solves with a tiered block after which it is queued for its -O1 build. The builder runs at idle
+# priority, so a build takes no time from the solves (a sweep that queued 90 blocks: the same wall within 2 %,
+# docs/decisions.md); what a build costs is a core's idle seconds. 10 s: one K = I sweep solves a structure for 14 s
+# (median), so a machine's second sweep, and a task's second run, find their blocks at -O1.
 # `DESIGNOPT_TIER_UP_AFTER` (seconds, or ``never``) overrides it.
-TIER_UP_AFTER = 60.0
+TIER_UP_AFTER = 10.0
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
 BUILDER_LOCK = "tier-up.lock"  # held (flock) by the cache's one tier-up builder while it runs
 
@@ -214,9 +215,9 @@ def start_builder(cache: Path) -> bool:
 
 
 def build_queued(cache: Path | str, idle: bool = False) -> int:
-    """The builder: while the cache's queue (`queue`) has blocks, build the oldest at -O1 (`tier_up`, here, one at
-    a time) and take it off the queue. Returns how many it built; 0 at once if another builder holds
-    `BUILDER_LOCK`. ``idle``: first lower this process (and so its gcc) to idle priority."""
+    """The builder: while the cache's queue (`queue`) has blocks, build them at -O1 (`tier_up`, here; oldest
+    first, one gcc per core at a time) and take them off the queue. Returns how many it built; 0 at once if another
+    builder holds `BUILDER_LOCK`. ``idle``: first lower this process (and so its gcc) to idle priority."""
     cache = Path(cache)
     if idle:
         _lower_priority()
@@ -228,17 +229,22 @@ def build_queued(cache: Path | str, idle: bool = False) -> int:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError:
                 return built  # another builder runs
-            while markers := _queued(cache, tried):
-                marker = markers[0]
-                tried.add(marker)
-                stem = _stem(marker)
-                if not library_at(stem, "O1").exists() and tier_up(stem, background=False):
-                    built += 1
-                marker.unlink(missing_ok=True)
+            with ThreadPoolExecutor(max(os.cpu_count() or 1, 1)) as pool:  # one gcc per core, each in idle time
+                while markers := _queued(cache, tried):
+                    tried.update(markers)
+                    built += sum(pool.map(_build_queued_one, markers))
         finally:
             os.close(fd)  # releases the lock
         if not _queued(cache, tried):  # nothing queued after the lock was let go: done
             return built
+
+
+def _build_queued_one(marker: Path) -> bool:
+    """Build one queued block at -O1 and take it off the queue; whether its build ran."""
+    stem = _stem(marker)
+    ran = not library_at(stem, "O1").exists() and tier_up(stem, background=False)
+    marker.unlink(missing_ok=True)
+    return ran
 
 
 def _queued(cache: Path, tried: set[Path] = frozenset()) -> list[Path]:
