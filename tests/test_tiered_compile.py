@@ -226,12 +226,12 @@ def _free(lock) -> bool:
 
 
 def _logging_compiler(tmp_path, fail: bool = False):
-    """A C compiler that appends 'start EPOCH POLICY' and 'end EPOCH' around gcc (or fails), POLICY being the
-    scheduling policy field of its /proc stat (5: SCHED_IDLE)."""
+    """A C compiler that appends 'start EPOCH POLICY SESSION' and 'end EPOCH' around gcc (or fails), POLICY and
+    SESSION being the scheduling policy (5: SCHED_IDLE) and session id fields of its /proc stat."""
     log, script = tmp_path / "cc.log", tmp_path / "cc.sh"
     run = "false" if fail else 'gcc "$@"'
     script.write_text("#!/bin/sh\n"
-                      f'echo "start $(date +%s.%N) $(cut -d" " -f41 /proc/$$/stat)" >> {log}\n'
+                      f'echo "start $(date +%s.%N) $(cut -d" " -f41,6 --output-delimiter=" " /proc/$$/stat)" >> {log}\n'
                       f"sleep 0.3; {run}; rc=$?\n"
                       f'echo "end $(date +%s.%N)" >> {log}\nexit $rc\n')
     script.chmod(script.stat().st_mode | stat.S_IEXEC)
@@ -240,8 +240,8 @@ def _logging_compiler(tmp_path, fail: bool = False):
 
 def test_queued_blocks_are_built_by_one_idle_builder_one_gcc_per_core(tmp_path, monkeypatch):
     """Blocks past the threshold in one solve are queued, not each given a compiler at once: one detached builder
-    compiles them, no more at a time than there are cores, at idle priority, and leaves no marker, no lock and
-    the -O1 libraries computing what the -O0 ones do."""
+    compiles them, no more at a time than there are cores, at idle priority and in the caller's session, and leaves
+    no marker, no lock and the -O1 libraries computing what the -O0 ones do."""
     cache = tmp_path / "cache"
     monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
     x = ca.SX.sym("x", 3)
@@ -268,8 +268,10 @@ def test_queued_blocks_are_built_by_one_idle_builder_one_gcc_per_core(tmp_path, 
     running = np.cumsum([step for _, step in events])
     assert running.max() <= (os.cpu_count() or 1)  # at most one gcc per core
     if hasattr(os, "SCHED_IDLE"):
-        policies = [runs[i + 2] for i in range(len(runs)) if runs[i] == "start"]
+        policies = [runs[i + 3] for i in range(len(runs)) if runs[i] == "start"]
         assert policies == [str(os.SCHED_IDLE)] * n
+    # in this process's session: a session of its own would be an autogroup the cores are shared with as an equal
+    assert [runs[i + 2] for i in range(len(runs)) if runs[i] == "start"] == [str(os.getsid(0))] * n
     assert not list(cache.glob("*.want")) and not list(cache.glob("*.so.lock"))
     assert cache_report().queued == 0
     x0 = np.array([0.4, -0.9, 1.3])

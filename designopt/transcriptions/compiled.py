@@ -8,13 +8,13 @@ Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at f
 compiled at gcc -O0 (about 1 s for the main job's Hessian block) and used so; every solve that used it adds its
 seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the block is queued (a
 marker file) for the cache's one builder: a detached process at idle priority (``SCHED_IDLE``, nice 19 where that
-does not exist) that compiles the queued blocks' C sources at -O1, oldest first and one at a time (about 10 s for
-that block), and exits when the queue is empty; later builds, in any process, load the -O1 library instead
-(`designopt cache` shows where each block stands). So a sweep that takes many blocks past the threshold at once
-runs one gcc beside its workers, in the time they leave, not one per block. Every library is compiled with
-``-ffp-contract=off`` (and never with -ffast-math), so -O0 and -O1 compute the same IEEE operations in the same
-order: a solve is the same to the last bit at either level, only faster at -O1 (the main job's default search:
-0.79x the CPU, docs/benchmarks.md).
+does not exist) that compiles the queued blocks' C sources at -O1, oldest first and one gcc per core (about 10 s
+for that block), and exits when the queue is empty; later builds, in any process, load the -O1 library instead
+(`designopt cache` shows where each block stands). So the builds take only the time the solves leave, and a sweep
+that takes a hundred blocks past the threshold at once does not start a hundred compilers beside its workers.
+Every library is compiled with ``-ffp-contract=off`` (and never with -ffast-math), so -O0 and -O1 compute the same
+IEEE operations in the same order: a solve is the same to the last bit at either level, only faster at -O1 (the
+main job's default search: 0.79x the CPU, docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -206,9 +206,12 @@ def start_builder(cache: Path) -> bool:
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [package_root, os.environ.get("PYTHONPATH")]))}
     code = ("import sys; from designopt.transcriptions.compiled import build_queued; "
             "build_queued(sys.argv[1], idle=True)")
+    # Its own process group (a Ctrl-C of the run does not reach it) but the caller's session: a new session would be
+    # a new scheduling autogroup, which Linux shares the cores with as an equal whatever its tasks' priority.
+    detached = {"process_group": 0} if sys.version_info >= (3, 11) else {}
     try:
-        subprocess.Popen([sys.executable, "-c", code, str(cache)], env=env, start_new_session=True,
-                         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        subprocess.Popen([sys.executable, "-c", code, str(cache)], env=env, stdin=subprocess.DEVNULL,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, **detached)
     except OSError:
         return False
     return True
