@@ -483,7 +483,6 @@ def cache(
     most = f"; most {r.counting[0][1]:.1f} s" if r.counting else ""
     threshold = "never" if after is None else f"{after:g} s of solving"
     table.add_row(f"blocks counting towards -O1 (at {threshold}){most}", str(len(r.counting)))
-    table.add_row("blocks queued for the -O1 builder", str(r.queued))
     table.add_row("-O1 builds under way", str(r.building))
     table.add_row("files of no current kind (--clear-other)", str(r.other))
     show(table)

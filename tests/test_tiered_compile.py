@@ -5,9 +5,7 @@ function as the independent truth."""
 
 from __future__ import annotations
 
-import fcntl
 import os
-import stat
 import time
 
 import casadi as ca
@@ -18,16 +16,10 @@ from designopt.problem import problem_from_config
 from designopt.solve import Seeded, SolverProfile, solve_guess
 from designopt.transcriptions import Collocation
 from designopt.transcriptions.compiled import (
-    BUILDER_LOCK,
-    build_queued,
-    cache_report,
     compiled,
     library_at,
-    queue,
-    queued_marker,
     record_work,
     source_of,
-    start_builder,
     tier_up_after,
 )
 from designopt.transcriptions.hessian import block_hessian_function
@@ -211,100 +203,3 @@ def test_the_cache_command_counts_levels_and_records_and_clears(tmp_path, monkey
     assert (tmp_path / "ldl_0123456789abcdef0123.so").exists()
     cleared = runner.invoke(app, ["cache", "--clear"])
     assert cleared.exit_code == 0 and "removed" in cleared.output and not list(tmp_path.iterdir())
-
-
-def _free(lock) -> bool:
-    """Whether no process holds an flock on ``lock``."""
-    fd = os.open(lock, os.O_CREAT | os.O_WRONLY)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        return True
-    except OSError:
-        return False
-    finally:
-        os.close(fd)
-
-
-def _logging_compiler(tmp_path, fail: bool = False):
-    """A C compiler that appends 'start EPOCH POLICY SESSION' and 'end EPOCH' around gcc (or fails), POLICY and
-    SESSION being the scheduling policy (5: SCHED_IDLE) and session id fields of its /proc stat."""
-    log, script = tmp_path / "cc.log", tmp_path / "cc.sh"
-    run = "false" if fail else 'gcc "$@"'
-    script.write_text("#!/bin/sh\n"
-                      f'echo "start $(date +%s.%N) $(cut -d" " -f41,6 --output-delimiter=" " /proc/$$/stat)" >> {log}\n'
-                      f"sleep 0.3; {run}; rc=$?\n"
-                      f'echo "end $(date +%s.%N)" >> {log}\nexit $rc\n')
-    script.chmod(script.stat().st_mode | stat.S_IEXEC)
-    return script, log
-
-
-def test_queued_blocks_are_built_by_one_idle_builder_one_gcc_per_core(tmp_path, monkeypatch):
-    """Blocks past the threshold in one solve are queued, not each given a compiler at once: one detached builder
-    compiles them, no more at a time than there are cores, at idle priority and in the caller's session, and leaves
-    no marker, no lock and the -O1 libraries computing what the -O0 ones do."""
-    cache = tmp_path / "cache"
-    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
-    x = ca.SX.sym("x", 3)
-    n = 2 * (os.cpu_count() or 1)  # more blocks than cores
-    fns = [ca.Function(f"q{i}", [x], [ca.sin(x[0] * (i + 1)) * ca.sumsqr(x) + x[1] * x[2] ** i]) for i in range(n)]
-    used = []
-    slow = [compiled(fn, "tiered", used) for fn in fns]
-    compiler, log = _logging_compiler(tmp_path)
-    monkeypatch.setenv("CC", str(compiler))
-    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
-    assert record_work(used, 1.0) == used  # all queued
-    stems = [_stem(lib) for lib in used]
-    deadline = time.time() + 120
-    while time.time() < deadline and not all(library_at(s, "O1").exists() for s in stems):
-        time.sleep(0.2)
-    assert all(library_at(s, "O1").exists() for s in stems)
-    while time.time() < deadline and not _free(cache / BUILDER_LOCK):  # the builder has exited
-        time.sleep(0.1)
-    runs = log.read_text().split()
-    starts = [float(runs[i + 1]) for i in range(len(runs)) if runs[i] == "start"]
-    ends = [float(runs[i + 1]) for i in range(len(runs)) if runs[i] == "end"]
-    assert len(starts) == len(ends) == n
-    events = sorted([(t, 1) for t in starts] + [(t, -1) for t in ends], key=lambda e: (e[0], e[1]))
-    running = np.cumsum([step for _, step in events])
-    assert running.max() <= (os.cpu_count() or 1)  # at most one gcc per core
-    if hasattr(os, "SCHED_IDLE"):
-        policies = [runs[i + 3] for i in range(len(runs)) if runs[i] == "start"]
-        assert policies == [str(os.SCHED_IDLE)] * n
-    # in this process's session: a session of its own would be an autogroup the cores are shared with as an equal
-    assert [runs[i + 2] for i in range(len(runs)) if runs[i] == "start"] == [str(os.getsid(0))] * n
-    assert not list(cache.glob("*.want")) and not list(cache.glob("*.so.lock"))
-    assert cache_report().queued == 0
-    x0 = np.array([0.4, -0.9, 1.3])
-    for fn, lib in zip(slow, used, strict=True):
-        fast = ca.external(fn.name(), str(library_at(_stem(lib), "O1")))
-        assert np.array_equal(np.array(fast(x0)), np.array(fn(x0)))
-
-
-def test_a_queue_is_left_to_the_builder_that_runs_and_a_failed_build_is_not_queued_again(tmp_path, monkeypatch):
-    """While another builder holds the builder's lock, a second one builds nothing and none is started; once it
-    is free the queue is built and emptied. A build that fails leaves its lock, so the block is not queued again
-    until that lock is stale; it stays at -O0."""
-    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
-    x = ca.SX.sym("x", 2)
-    used = []
-    compiled(ca.Function("qa", [x], [ca.cos(x[0]) * x[1] ** 3]), "tiered", used)
-    compiled(ca.Function("qb", [x], [ca.exp(x[1]) * x[0]]), "tiered", used)
-    good, bad = (_stem(lib) for lib in used)
-    assert queue(good) and not queue(good)  # once
-    assert cache_report().queued == 1
-    fd = os.open(tmp_path / BUILDER_LOCK, os.O_CREAT | os.O_WRONLY)
-    fcntl.flock(fd, fcntl.LOCK_EX)
-    try:
-        assert build_queued(tmp_path) == 0 and not start_builder(tmp_path)
-        assert queued_marker(good).exists() and not library_at(good, "O1").exists()
-    finally:
-        os.close(fd)
-    assert build_queued(tmp_path) == 1 and library_at(good, "O1").exists() and not queued_marker(good).exists()
-    compiler, _ = _logging_compiler(tmp_path, fail=True)
-    monkeypatch.setenv("CC", str(compiler))
-    assert queue(bad) and build_queued(tmp_path) == 1  # tried, and failed
-    target = library_at(bad, "O1")
-    assert not target.exists() and not queued_marker(bad).exists()
-    assert target.with_name(target.name + ".lock").exists() and not queue(bad)
-    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
-    assert record_work(used, 1.0) == [] and cache_report().queued == 0

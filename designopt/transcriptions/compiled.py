@@ -6,30 +6,24 @@ between processes: each library is written under a temporary name and renamed in
 
 Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block is first
 compiled at gcc -O0 (about 1 s for the main job's Hessian block) and used so; every solve that used it adds its
-seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the block is queued (a
-marker file) for the cache's one builder: a detached process at idle priority (``SCHED_IDLE``, nice 19 where that
-does not exist) that compiles the queued blocks' C sources at -O1, oldest first and one gcc per core (about 10 s
-for that block), and exits when the queue is empty; later builds, in any process, load the -O1 library instead
-(`designopt cache` shows where each block stands). So the builds take only the time the solves leave, and a sweep
-that takes a hundred blocks past the threshold at once does not start a hundred compilers beside its workers.
-Every library is compiled with ``-ffp-contract=off`` (and never with -ffast-math), so -O0 and -O1 compute the same
-IEEE operations in the same order: a solve is the same to the last bit at either level, only faster at -O1 (the
-main job's default search: 0.79x the CPU, docs/benchmarks.md).
+seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the same C source is
+compiled again at -O1 in a detached background process (about 10 s for that block), which later builds, in any
+process, load instead (`designopt cache` shows where each block stands). Every library is compiled with
+``-ffp-contract=off`` (and never with -ffast-math), so -O0 and -O1 compute the same IEEE operations in the same
+order: a solve is the same to the last bit at either level, only faster at -O1 (the main job's default search:
+0.79x the CPU, docs/benchmarks.md).
 """
 
 from __future__ import annotations
 
-import fcntl
 import gzip
 import hashlib
 import os
 import shlex
 import subprocess
-import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,14 +39,13 @@ FLAGS = ("-fPIC", "-shared", "-ffp-contract=off")
 # machine (the cache), paid back within one solve from some 500 points (a program of 250 waypoints with a cell).
 # Below it, ``tiered``: O0 first, O1 once the block has been solved with long enough to pay for it (module doc).
 AUTO_O1_FROM = 500
-# Seconds of solves with a tiered block after which it is queued for its -O1 build. The builder runs at idle
-# priority, so a build takes no time from the solves (a sweep that queued 90 blocks: the same wall within 2 %,
-# docs/decisions.md); what a build costs is a core's idle seconds. 10 s: one K = I sweep solves a structure for 14 s
-# (median), so a machine's second sweep, and a task's second run, find their blocks at -O1.
+# Seconds of solves with a tiered block after which its -O1 build starts: the solving whose -O0 penalty (about a
+# fifth of it on the main job) adds up to what gcc -O1 takes for the main job's blocks (about 10 s) -- the
+# ski-rental rule, which never costs more than twice what knowing the future would. A sweep's structure is solved
+# for about 15 s and never tiers up; a task run again and again does from its second run.
 # `DESIGNOPT_TIER_UP_AFTER` (seconds, or ``never``) overrides it.
-TIER_UP_AFTER = 10.0
+TIER_UP_AFTER = 60.0
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
-BUILDER_LOCK = "tier-up.lock"  # held (flock) by the cache's one tier-up builder while it runs
 
 
 def level(mode: str, points: int) -> str:
@@ -144,10 +137,9 @@ def _stem(library: Path) -> Path:
 
 def record_work(libraries: Iterable[Path], seconds: float, background: bool = True) -> list[Path]:
     """Count ``seconds`` of solving towards the tier-up of each tiered -O0 library in ``libraries`` (paths that
-    `compiled_as` appended to its ``used``), and have each whose count has reached `tier_up_after` built at -O1:
-    queued for the cache's builder (`build_queued`, started here in the background if none runs), or built here
-    and now when ``background`` is false (one process builds it, others find its lock). Returns the libraries
-    this call queued (or built)."""
+    `compiled_as` appended to its ``used``), and start the -O1 build of each whose count has reached
+    `tier_up_after` (in a detached background process unless ``background`` is false;
+    one process builds it, others find its lock). Returns the libraries whose -O1 build this call started."""
     after = tier_up_after()
     started = []
     for library in dict.fromkeys(libraries):  # once each, in order
@@ -161,117 +153,9 @@ def record_work(libraries: Iterable[Path], seconds: float, background: bool = Tr
             total = sum(float(v) for v in record.read_text().split() if _is_number(v))
         except OSError:  # a cache that cannot be written (read-only, full): the block stays at -O0
             continue
-        if total >= after and (queue(stem) if background else tier_up(stem, background=False)):
+        if total >= after and tier_up(stem, background):
             started.append(library)
-    if background and started:
-        start_builder(_stem(started[0]).parent)
     return started
-
-
-def queued_marker(stem: Path) -> Path:
-    """The marker file that queues ``stem``'s -O1 build for the builder."""
-    return library_at(stem, "O1").with_suffix(".want")
-
-
-def queue(stem: Path) -> bool:
-    """Queue ``stem``'s -O1 build for the cache's builder; False if it is queued already, or its build's lock is
-    held (a build under way, or one that failed less than `STALE_LOCK_S` ago)."""
-    lock = library_at(stem, "O1").with_name(f"{library_at(stem, 'O1').name}.lock")
-    try:
-        if time.time() - lock.stat().st_mtime < STALE_LOCK_S:
-            return False
-    except FileNotFoundError:
-        pass
-    try:
-        os.close(os.open(queued_marker(stem), os.O_CREAT | os.O_EXCL | os.O_WRONLY))
-        return True
-    except OSError:  # queued already, or a cache that cannot be written
-        return False
-
-
-def start_builder(cache: Path) -> bool:
-    """Start the cache's builder (`build_queued`) as a detached process unless one runs (it holds
-    `BUILDER_LOCK`). True if one was started. Two callers may both start one; the second exits at once."""
-    try:
-        fd = os.open(cache / BUILDER_LOCK, os.O_CREAT | os.O_WRONLY)
-    except OSError:
-        return False
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # free: released at once, for the builder to take
-    except OSError:
-        return False
-    finally:
-        os.close(fd)
-    package_root = str(Path(__file__).resolve().parents[2])
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [package_root, os.environ.get("PYTHONPATH")]))}
-    code = ("import sys; from designopt.transcriptions.compiled import build_queued; "
-            "build_queued(sys.argv[1], idle=True)")
-    # Its own process group (a Ctrl-C of the run does not reach it) but the caller's session: a new session would be
-    # a new scheduling autogroup, which Linux shares the cores with as an equal whatever its tasks' priority.
-    detached = {"process_group": 0} if sys.version_info >= (3, 11) else {}
-    try:
-        subprocess.Popen([sys.executable, "-c", code, str(cache)], env=env, stdin=subprocess.DEVNULL,
-                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, **detached)
-    except OSError:
-        return False
-    return True
-
-
-def build_queued(cache: Path | str, idle: bool = False) -> int:
-    """The builder: while the cache's queue (`queue`) has blocks, build them at -O1 (`tier_up`, here; oldest
-    first, one gcc per core at a time) and take them off the queue. Returns how many it built; 0 at once if another
-    builder holds `BUILDER_LOCK`. ``idle``: first lower this process (and so its gcc) to idle priority."""
-    cache = Path(cache)
-    if idle:
-        _lower_priority()
-    built, tried = 0, set()
-    while True:
-        fd = os.open(cache / BUILDER_LOCK, os.O_CREAT | os.O_WRONLY)
-        try:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                return built  # another builder runs
-            with ThreadPoolExecutor(max(os.cpu_count() or 1, 1)) as pool:  # one gcc per core, each in idle time
-                while markers := _queued(cache, tried):
-                    tried.update(markers)
-                    built += sum(pool.map(_build_queued_one, markers))
-        finally:
-            os.close(fd)  # releases the lock
-        if not _queued(cache, tried):  # nothing queued after the lock was let go: done
-            return built
-
-
-def _build_queued_one(marker: Path) -> bool:
-    """Build one queued block at -O1 and take it off the queue; whether its build ran."""
-    stem = _stem(marker)
-    ran = not library_at(stem, "O1").exists() and tier_up(stem, background=False)
-    marker.unlink(missing_ok=True)
-    return ran
-
-
-def _queued(cache: Path, tried: set[Path] = frozenset()) -> list[Path]:
-    """The queued markers, oldest first, but for those in ``tried``."""
-    markers = []
-    for marker in cache.glob("*.O1.want"):
-        try:
-            if marker not in tried:
-                markers.append((marker.stat().st_mtime, marker.name, marker))
-        except FileNotFoundError:
-            continue
-    return [m for *_, m in sorted(markers)]
-
-
-def _lower_priority() -> None:
-    """This process and its children at idle priority: ``SCHED_IDLE`` (they run only when a core has nothing
-    else to do), or nice 19 where that does not exist."""
-    try:
-        os.sched_setscheduler(0, os.SCHED_IDLE, os.sched_param(0))
-    except (AttributeError, OSError):
-        try:
-            os.nice(19)
-        except OSError:
-            pass
 
 
 def tiered_up(libraries: Iterable[Path]) -> bool:
@@ -363,26 +247,22 @@ def _compile_command(c_file: Path, library: Path, mode: str) -> list[str]:
 @dataclass(frozen=True)
 class CacheReport:
     """What the compile cache holds: libraries by level (``tiered_up``: -O1 libraries built from a tiered block's
-    kept source), blocks still counting towards their tier-up and the seconds of solving each has, blocks queued
-    for the builder, tier-up builds under way (locks), files of no current kind (an older designopt's libraries,
-    temporary files of a build that died), and the bytes of it all."""
+    kept source), blocks still counting towards their tier-up and the seconds of solving each has, tier-up builds
+    under way (locks), files of no current kind (an older designopt's libraries, temporary files of a build that
+    died), and the bytes of it all."""
 
     path: Path
     libraries: dict[str, int]
     tiered_up: int
     counting: tuple[tuple[str, float], ...]
-    queued: int
     building: int
     other: int
     bytes: int
 
 
 def _kind(name: str) -> str:
-    """A cache file's kind from its name: ``O0``/``O1``/``O2`` (a library), ``source``, ``work``, ``queued``,
-    ``lock``, ``builder`` (`BUILDER_LOCK`), ``ldl`` (the KKT solver's library, `designopt.solve.backends.ldl`) or
-    ``other``."""
-    if name == BUILDER_LOCK:
-        return "builder"
+    """A cache file's kind from its name: ``O0``/``O1``/``O2`` (a library), ``source``, ``work``, ``lock``, ``ldl``
+    (the KKT solver's library, `designopt.solve.backends.ldl`) or ``other``."""
     parts = name.split(".")
     if name.startswith("ldl_") and len(parts) == 2 and parts[1] == "so":
         return "ldl"
@@ -392,8 +272,6 @@ def _kind(name: str) -> str:
         return "source"
     if len(parts) == 2 and parts[1] == "work":
         return "work"
-    if len(parts) == 3 and parts[1:] == ["O1", "want"]:
-        return "queued"
     if name.endswith(".so.lock") and len(parts) == 4:
         return "lock"
     return "other"
@@ -411,7 +289,7 @@ def cache_report(path: Path | None = None) -> CacheReport:
     counting = []
     for f, k in kinds.items():
         stem = _stem(f).name
-        if k == "work" and f"{stem}.O1.so" not in names and f"{stem}.O1.want" not in names:
+        if k == "work" and f"{stem}.O1.so" not in names:
             try:
                 seconds = sum(float(v) for v in f.read_text().split() if _is_number(v))
             except OSError:
@@ -419,7 +297,6 @@ def cache_report(path: Path | None = None) -> CacheReport:
             counting.append((stem, seconds))
     return CacheReport(path=path, libraries=libraries, tiered_up=tiered_up,
                        counting=tuple(sorted(counting, key=lambda c: -c[1])),
-                       queued=sum(k == "queued" for k in kinds.values()),
                        building=sum(k == "lock" for k in kinds.values()),
                        other=sum(k == "other" for k in kinds.values()),
                        bytes=sum(f.stat().st_size for f in files))
