@@ -47,9 +47,9 @@ class Search:
     linear solver instead of the profile's (None: the profile's; `SolverProfile.linear_solver`).
     ``refine_mu_init``: the barrier parameters the refine's warm solves start from (IPOPT's ``mu_init``; None: the
     warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate refined once per value (stages
-    ``refine``, ``refine2``, ...; the answer is the best of all): from
-    a small one a refine stays in the basin its screened start is in, from the warm start's it sometimes walks
-    into a better one and more often into a worse one. ``screen_mu_init``: the same for the screen (stages
+    ``refine``, ``refine2``, ...; the answer is the best of all): from a small one a refine stays in the basin its
+    screened start is in, from the warm start's it sometimes walks into a better one and more often into a worse
+    one. ``screen_mu_init``: the same for the screen (stages
     ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``reflect``: after the
     strategy and the neighbour step, up to this many rounds (stages ``reflect``, ``reflect2``, ...) in which each
     problem's best full-path solution is reflected across the length bounds it lies at (the same arm with that
