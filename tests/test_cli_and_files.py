@@ -192,7 +192,7 @@ def test_every_best_design_known_checks_out():
     kept = sorted((root / "benchmarks" / "reference").glob("*_best_known.json"))
     assert {p.name for p in kept} >= {"milling_best_known.json", "modular_best_known.json",
                                       "circle_standoff_best_known.json", "milling_physical_best_known.json",
-                                      "structures_physical_best_known.json"}
+                                      "structures_physical_best_known.json", "structures_k_i_best_known.json"}
     for path in kept:
         assert verify_file(path) == [], path
     modules = set(catalogue_from_config(load_config(root / "configs" / "modular.yaml")).modules)
