@@ -16,9 +16,9 @@ from conftest import solve
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from designopt.config import parse_config
+from designopt.config import load_config, parse_config
 from designopt.costs import tracking_residual
-from designopt.experiments.adapters import search_from_config
+from designopt.experiments.adapters import search_from_config, structure_config
 from designopt.initial_guess import (
     _moved_onto_path,
     beyond_reach,
@@ -47,7 +47,7 @@ from designopt.solve import (
 from designopt.solve.optima import design_forms, form_joints
 from designopt.solve.starts import Rebranched
 from designopt.solve.strategies import coarse_to_fine
-from designopt.solve.strategies.coarse_to_fine import coarse_problem, rebranched_tasks
+from designopt.solve.strategies.coarse_to_fine import coarse_problem, exploration_starts, rebranched_tasks
 from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import units
 from designopt.toolpaths import figure_eight, subsample
@@ -405,6 +405,35 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
     assert list(added.second_round(np.array([t.seed for t in seeded + rebranched]))) == (
         [False] * len(seeded) + [True] * len(rebranched))
 
+
+
+def test_a_smaller_problem_of_a_batch_gets_more_exploration_starts():
+    """`Search.small_problem_starts`: in a batch, a problem with fewer unknowns n (moving joints x the exploration's
+    waypoints + design joints) gets starts x (n_max / n)^2, at most that factor x starts; 1 (the default), one
+    problem alone, or problems of one size: ``starts`` each. The plan explores each problem with its own count, and
+    the second round's starts (numbered after the most any problem gets) stay told apart from the first's."""
+    sweep = load_config(Path(__file__).parent.parent / "configs" / "structures.yaml")
+    rrr, six = (problem_from_config(structure_config(sweep, s)) for s in ("RRR", "RRRRRR"))
+    # every link's d or theta, a, alpha and the six placement joints designed: n = 10 N + 3 N + 6
+    assert (rrr.chain.n_moving, rrr.chain.n_design, six.chain.n_design) == (3, 15, 24)
+    n_rrr, n_six = 10 * 3 + 15, 10 * 6 + 24
+    more = Search(starts=40, small_problem_starts=4)
+    assert exploration_starts([six, rrr, six], more) == [40, round(40 * (n_six / n_rrr) ** 2), 40] == [40, 139, 40]
+    assert exploration_starts([rrr, six], replace(more, small_problem_starts=2)) == [80, 40]
+    assert exploration_starts([rrr, six], Search(starts=40)) == [40, 40]
+    assert exploration_starts([rrr], more) == exploration_starts([rrr, rrr], more)[:1] == [40]
+    assert "up to 4x as many" in more.describe() and "as many" not in Search(starts=40).describe()
+
+    jobs = [Job("", rrr), Job("", six)]
+    explore = next(coarse_to_fine.plan(jobs, replace(more, seed=3)))
+    counts = {s: sum(t.problem.chain.structure == s for t in explore) for s in ("RRR", "RRRRRR")}
+    assert counts == {"RRR": 139, "RRRRRR": 40}
+    assert all(t.problem.toolpath.n == more.explore_waypoints for t in explore)
+    assert more.most_starts == 160 and not any(more.second_round(t.seed) for t in explore)
+    sol = _optimum(rrr, 1.0, (0, 0), 0.0)
+    rebranched = rebranched_tasks([[(explore[0], sol)]], replace(more, rebranch=1, seed=3))
+    assert [t.start.index for t in rebranched] == list(range(160, 200))
+    assert all(more.second_round(t.seed) for t in rebranched)
 
 def test_the_screen_takes_at_most_screen_per_form_of_one_form():
     """`Search.screen_per_form`: the screen lifts the distinct coarse optima in order of cost, at most that many of

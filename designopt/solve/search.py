@@ -9,6 +9,7 @@ what it returns is one `Searched` per job. `designopt.solve.strategies.run_searc
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 from designopt.initial_guess import start_index
@@ -53,7 +54,10 @@ class Search:
     ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``reflect``: after the
     strategy and the neighbour step, up to this many rounds (stages ``reflect``, ``reflect2``, ...) in which each
     problem's best full-path solution is reflected across the length bounds it lies at (the same arm with that
-    length's sign flipped) and solved warm (`strategies.reflect`); 0: none.
+    length's sign flipped) and solved warm (`strategies.reflect`); 0: none. ``small_problem_starts``: in a search
+    of several problems (a sweep's structures), a problem with fewer unknowns than the largest gets more exploration
+    starts, as many as cost about what the largest one's ``starts`` cost, at most this many times ``starts``
+    (`strategies.coarse_to_fine.exploration_starts`); 1: every problem ``starts``.
     """
 
     strategy: str = "coarse_to_fine"
@@ -81,16 +85,24 @@ class Search:
     screen_mu_init: tuple[float | None, ...] = (None,)
     refine_mu_init: tuple[float | None, ...] = (None,)
     reflect: int = 0
+    small_problem_starts: float = 1.0
 
     @property
     def rebranch_starts(self) -> int:
         """Starts on new joint branches per rebranched optimum: the second round as large as the first."""
         return max(1, self.starts // self.rebranch) if self.rebranch else 0
 
+    @property
+    def most_starts(self) -> int:
+        """The most exploration starts one problem gets (`exploration_starts`): the second round's start indices
+        follow them."""
+        return math.ceil(self.starts * max(self.small_problem_starts, 1.0))
+
     def second_round(self, number):
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,
-        on a new joint branch: its index (`initial_guess.start_index`) from ``starts`` on (`rebranched_tasks`)."""
-        return start_index(number) >= self.starts
+        on a new joint branch: its index (`initial_guess.start_index`) from ``most_starts`` on
+        (`rebranched_tasks`)."""
+        return start_index(number) >= self.most_starts
 
     def describe(self) -> str:
         """The search in words."""
@@ -122,6 +134,9 @@ class Search:
                  f"new joint branch" if self.rebranch else "")
         kkt = self._kkt(self.explore_linear_solver)
         barrier = _barriers(self.refine_mu_init)
+        if self.small_problem_starts > 1:
+            drawn += (f" (a problem smaller than the largest up to {self.small_problem_starts:g}x as many, "
+                      f"about its cost)")
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){reflect}{held}{solver}")

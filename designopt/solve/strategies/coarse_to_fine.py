@@ -4,7 +4,8 @@ A start's objective after a few hundred IPOPT iterations barely predicts where i
 waypoints does: a design optimal for a coarse sampling of the path lies, more often than not, in the basin of a
 design optimal for the full path. Stages, each across every problem:
 
-1. ``explore``: ``search.starts`` cold seeded starts of the *coarse problem* -- the same robot, placement, costs and
+1. ``explore``: ``search.starts`` cold seeded starts (a smaller problem of several more: `exploration_starts`) of
+   the *coarse problem* -- the same robot, placement, costs and
    cell on ``explore_waypoints`` of the path's waypoints (`coarse_problem`) -- each capped at
    ``explore_max_iter``. A coarse solve costs about a tenth of a full one. Then the ``rebranch`` best distinct
    coarse optima (at most ``rebranch_per_form`` of one form, when set; and the cheapest of up to
@@ -38,6 +39,21 @@ from designopt.toolpaths import subsample
 def coarse_problem(problem: DesignProblem, waypoints: int) -> DesignProblem:
     """The same problem on ``waypoints`` of its path's waypoints (first and last kept)."""
     return replace(problem, toolpath=subsample(problem.toolpath, waypoints))
+
+
+def exploration_starts(problems: list[DesignProblem], search) -> list[int]:
+    """Exploration starts per problem: ``search.starts`` each; with ``search.small_problem_starts`` above 1, a
+    problem with fewer unknowns n than the largest of ``problems`` gets starts x (n_max / n)^2, rounded, at most
+    ``small_problem_starts`` x starts. n counts the exploration problem's joints (moving joints x
+    ``explore_waypoints``) and design joints. A start's CPU grows about as n^2 (iterations and their cost both grow
+    with n; a K = I sweep: 0.038, 0.069, 0.097, 0.144 s per start of its 3-, 4-, 5- and 6-joint structures, where
+    (n_max / n)^2 predicts 3.5, 2.1, 1.4 and 1 times the last), so each problem's exploration costs about the largest
+    one's: a small structure, whose starts are cheap and whose basins its `starts` miss, gets more of them."""
+    if search.small_problem_starts <= 1:
+        return [search.starts] * len(problems)
+    size = [p.chain.n_moving * min(search.explore_waypoints, p.toolpath.n) + p.chain.n_design for p in problems]
+    largest = max(size, default=1)
+    return [round(search.starts * min(search.small_problem_starts, (largest / n) ** 2)) for n in size]
 
 
 def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, search, max_iter: int | None = None,
@@ -78,7 +94,7 @@ def rebranched_tasks(found, search) -> list[Task]:
     (at most ``search.rebranch_per_form`` of one form before other forms: `optima.distinct_best`), and the
     cheapest of each of up to ``search.rebranch_new_forms`` forms not among them, each started
     ``search.rebranch_starts`` (``starts // rebranch``) times on a new joint branch, as the task that found it (the
-    same coarse problem, profile and continuation); start indices follow the exploration's (``search.starts``
+    same coarse problem, profile and continuation); start indices follow the exploration's (``search.most_starts``
     onwards)."""
     tasks, m = [], search.rebranch_starts
     for done in found:
@@ -87,17 +103,17 @@ def rebranched_tasks(found, search) -> list[Task]:
         for k, i in enumerate(leaders):
             first, sol = done[i]
             for j in range(m):
-                start = Rebranched(sol, search.seed, search.starts + k * m + j, search.init)
+                start = Rebranched(sol, search.seed, search.most_starts + k * m + j, search.init)
                 tasks.append(replace(first, start=start))
     return tasks
 
 
 def plan(jobs, search):
     explore = []
-    for job in jobs:
+    for job, starts in zip(jobs, exploration_starts([job.problem for job in jobs], search), strict=True):
         coarse = coarse_problem(job.problem, search.explore_waypoints)
         profile = search.profile.capped(search.explore_max_iter).solved_by(search.explore_linear_solver)
-        explore += seeded_tasks(job, "explore", coarse, profile, search, search.starts)
+        explore += seeded_tasks(job, "explore", coarse, profile, search, starts)
     explored = by_job(jobs, (yield explore))
     if search.rebranch:
         again = by_job(jobs, (yield rebranched_tasks(explored, search)))
