@@ -77,7 +77,7 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert "drawn from the task's box" in boxed.describe() and "box" not in PRESETS["default"].describe()
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4,
-                                             reflect=3, seed=2, explore_linear_solver="ldl",
+                                             reflect=3, small_problem_starts=4, seed=2, explore_linear_solver="ldl",
                                              screen_linear_solver="ldl", profile=PRESETS["quick"].profile)
     # a stage's own linear solver is named in the search's words, the profile's is not
     quick = PRESETS["quick"].describe()

@@ -189,7 +189,11 @@ PRESETS: dict[str, Search] = {
     # gain nothing): on fresh seeds 2130 and 2131 (replays from the screen on, side by side) the screen's solver time
     # 0.69x, the replayed stages' 0.894x both, structure bests lower / higher by > 1 % 9 / 12 and 19 / 7, references
     # within 1.10x 4 -> 4 and 4 -> 5 (docs/decisions.md, "Speed")
-    "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3,
+    # A structure with fewer joints explores with more starts, about what a 6-joint structure's 40 cost, at most 160
+    # (`small_problem_starts`; 5, 4, 3 joints: 56, 84, 139 starts): on fresh K = I seeds 2141 and 2142 (whole
+    # sweeps, side by side), references within 1.10x 4 -> 4 and 5 -> 7, structure bests lower / higher by > 1 % 5 / 2
+    # and 8 / 6, at 1.107x and 1.088x the solver time (docs/decisions.md, 2026-11-29)
+    "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
                     explore_linear_solver="ldl", screen_linear_solver="ldl",
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
