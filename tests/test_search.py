@@ -406,7 +406,6 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
         [False] * len(seeded) + [True] * len(rebranched))
 
 
-
 def test_a_smaller_problem_of_a_batch_gets_more_exploration_starts():
     """`Search.small_problem_starts`: in a batch, a problem with fewer unknowns n (moving joints x the exploration's
     waypoints + design joints) gets starts x (n_max / n)^2, at most that factor x starts; 1 (the default), one
@@ -434,6 +433,7 @@ def test_a_smaller_problem_of_a_batch_gets_more_exploration_starts():
     rebranched = rebranched_tasks([[(explore[0], sol)]], replace(more, rebranch=1, seed=3))
     assert [t.start.index for t in rebranched] == list(range(160, 200))
     assert all(more.second_round(t.seed) for t in rebranched)
+
 
 def test_the_screen_takes_at_most_screen_per_form_of_one_form():
     """`Search.screen_per_form`: the screen lifts the distinct coarse optima in order of cost, at most that many of
