@@ -317,9 +317,10 @@ def start_number(seed: int, index: int) -> int:
     return seed * STARTS_PER_SEED + index
 
 
-def start_index(number):
-    """The index of the start numbered ``number`` (an int or an array of them) within its seed's starts."""
-    return number % STARTS_PER_SEED
+def start_index(number, seed: int):
+    """The index of the start numbered ``number`` (an int or an array of them) within ``seed``'s starts: the inverse
+    of `start_number` for any index, also past ``STARTS_PER_SEED`` (a run has one seed, so numbers are unique)."""
+    return number - seed * STARTS_PER_SEED
 
 
 def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik",

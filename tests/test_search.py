@@ -26,6 +26,8 @@ from designopt.initial_guess import (
     initial_guess,
     projected,
     residual_function,
+    start_index,
+    start_number,
 )
 from designopt.problem import problem_from_config
 from designopt.solution import solve_and_evaluate
@@ -398,8 +400,9 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
     assert [t.start.number for t in after] == list(range(4, 4 + 4 * added.rebranch_starts))
     assert "up to 2 forms not among them" in added.describe()
     # a start's number tells the rounds apart, as the benchmarks read them back from a run's files
-    seeded = seeded_tasks(Job("", problem), "explore", problem, SolverProfile(), replace(added, seed=7), added.starts)
-    rebranched = rebranched_tasks([[(task, s) for s in sols]], replace(added, seed=7))
+    added = replace(added, seed=7)
+    seeded = seeded_tasks(Job("", problem), "explore", problem, SolverProfile(), added, added.starts)
+    rebranched = rebranched_tasks([[(task, s) for s in sols]], added)
     assert not any(added.second_round(t.seed) for t in seeded)
     assert all(added.second_round(t.seed) for t in rebranched)
     assert list(added.second_round(np.array([t.seed for t in seeded + rebranched]))) == (
@@ -424,15 +427,34 @@ def test_a_smaller_problem_of_a_batch_gets_more_exploration_starts():
     assert "up to 4x as many" in more.describe() and "as many" not in Search(starts=40).describe()
 
     jobs = [Job("", rrr), Job("", six)]
-    explore = next(coarse_to_fine.plan(jobs, replace(more, seed=3)))
+    more = replace(more, seed=3)
+    explore = next(coarse_to_fine.plan(jobs, more))
     counts = {s: sum(t.problem.chain.structure == s for t in explore) for s in ("RRR", "RRRRRR")}
     assert counts == {"RRR": 139, "RRRRRR": 40}
     assert all(t.problem.toolpath.n == more.explore_waypoints for t in explore)
     assert more.most_starts == 160 and not any(more.second_round(t.seed) for t in explore)
     sol = _optimum(rrr, 1.0, (0, 0), 0.0)
-    rebranched = rebranched_tasks([[(explore[0], sol)]], replace(more, rebranch=1, seed=3))
+    rebranched = rebranched_tasks([[(explore[0], sol)]], replace(more, rebranch=1))
     assert [t.start.index for t in rebranched] == list(range(160, 200))
     assert all(more.second_round(t.seed) for t in rebranched)
+
+
+def test_the_second_round_is_told_apart_past_a_thousand_starts():
+    """A start's number is seed x 1000 + index (`initial_guess.start_number`), and a config may ask for up to
+    100,000 starts: `Search.second_round` reads the index back for any count, so start 1,100 of seed 3 is of the
+    first round of a 1,200-start search and start 1,200 (the first rebranched) of the second, as
+    `rebranched_tasks` numbers them."""
+    big = Search(starts=1200, rebranch=4, seed=3)
+    assert start_index(start_number(3, 1100), 3) == 1100
+    assert not big.second_round(start_number(3, 1100)) and not big.second_round(start_number(3, 0))
+    problem = problem_from_config(parse_config({}))
+    task = Task("", "explore", problem, Collocation(), SolverProfile(), Seeded(3, 0))
+    sol = _optimum(problem, 1.0, (0, 0, 1, 0, 1), 0.0)
+    rebranched = rebranched_tasks([[(task, sol)]], big)
+    assert [t.start.index for t in rebranched] == list(range(1200, 1500))
+    assert all(big.second_round(t.seed) for t in rebranched)
+    assert list(big.second_round(np.array([start_number(3, 999), start_number(3, 1199), start_number(3, 1200)]))) == [
+        False, False, True]
 
 
 def test_the_screen_takes_at_most_screen_per_form_of_one_form():

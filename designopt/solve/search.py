@@ -102,7 +102,7 @@ class Search:
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,
         on a new joint branch: its index (`initial_guess.start_index`) from ``most_starts`` on
         (`rebranched_tasks`)."""
-        return start_index(number) >= self.most_starts
+        return start_index(number, self.seed) >= self.most_starts
 
     def describe(self) -> str:
         """The search in words."""
