@@ -49,7 +49,12 @@ from designopt.solve import (
 from designopt.solve.optima import design_forms, form_joints
 from designopt.solve.starts import Rebranched
 from designopt.solve.strategies import coarse_to_fine
-from designopt.solve.strategies.coarse_to_fine import coarse_problem, exploration_starts, rebranched_tasks
+from designopt.solve.strategies.coarse_to_fine import (
+    coarse_problem,
+    exploration_starts,
+    rebranched_tasks,
+    screening,
+)
 from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import units
 from designopt.toolpaths import figure_eight, subsample
@@ -455,6 +460,34 @@ def test_the_second_round_is_told_apart_past_a_thousand_starts():
     assert all(big.second_round(t.seed) for t in rebranched)
     assert list(big.second_round(np.array([start_number(3, 999), start_number(3, 1199), start_number(3, 1200)]))) == [
         False, False, True]
+
+
+def test_a_smaller_problem_of_a_batch_is_screened_on_more_candidates_and_waypoints():
+    """`Search.small_problem_starts` and the screen (`coarse_to_fine.screening`): a problem explored with k times the
+    starts screens k times the candidates, on the waypoints w that make its screen problem as large as the largest
+    one's (m w + d = n_max), the full path once w reaches its count; without the factor, or alone, the search's own.
+    Driven through the plan too: the explored solves in, each job's screen tasks out."""
+    sweep = load_config(Path(__file__).parent.parent / "configs" / "structures.yaml")
+    rrr, rrrr, six = (problem_from_config(structure_config(sweep, s)) for s in ("RRR", "RRRR", "RRRRRR"))
+    assert {p.toolpath.n for p in (rrr, rrrr, six)} == {40}
+    more = Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, small_problem_starts=4)
+    assert exploration_starts([rrr, rrrr, six], more) == [139, 84, 40]
+    # on 20 waypoints six joints are 6 x 20 + 24 = 144 unknowns: RRRR (d = 18) w = 126 / 4 = 31.5 -> 32, RRR
+    # (d = 15) w = 129 / 3 = 43 >= 40 waypoints: the full path; candidates 12 x 139 / 40 = 41.7 and 12 x 84 / 40 = 25.2
+    assert screening([rrr, rrrr, six], more) == [(42, None), (25, 32), (12, 20)]
+    assert screening([rrr, six], replace(more, small_problem_starts=1)) == [(12, 20)] * 2
+    assert screening([rrrr], more) == [(12, 20)]
+    assert "more, on more waypoints" in more.describe() and "more waypoints" not in Search().describe()
+
+    plan = coarse_to_fine.plan([Job("a", rrr), Job("b", six)], more)
+    explore = next(plan)
+    sols = [_optimum(t.problem, float(k), (0,) * int(form_joints(t.problem.chain).sum()), 0.05 * k)
+            for k, t in enumerate(explore)]
+    screen = plan.send(list(zip(explore, sols, strict=True)))
+    assert [sum(t.case == case for t in screen) for case in "ab"] == [42, 12]
+    assert {t.problem.toolpath.n for t in screen if t.case == "a"} == {40}
+    assert {t.problem.toolpath.n for t in screen if t.case == "b"} == {20}
+    assert [t.start.solution for t in screen if t.case == "a"] == sols[:42]  # the cheapest distinct, in order
 
 
 def test_the_screen_takes_at_most_screen_per_form_of_one_form():

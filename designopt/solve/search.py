@@ -57,7 +57,9 @@ class Search:
     length's sign flipped) and solved warm (`strategies.reflect`); 0: none. ``small_problem_starts``: in a search
     of several problems (a sweep's structures), a problem with fewer unknowns than the largest gets more exploration
     starts, as many as cost about what the largest one's ``starts`` cost, at most this many times ``starts``
-    (`strategies.coarse_to_fine.exploration_starts`); 1: every problem ``starts``.
+    (`strategies.coarse_to_fine.exploration_starts`), and screens as many times more candidates on as many more
+    waypoints as keep its screen the largest one's size (`strategies.coarse_to_fine.screening`); 1: every problem
+    ``starts``, ``screen`` and ``screen_waypoints``.
     """
 
     strategy: str = "coarse_to_fine"
@@ -123,6 +125,8 @@ class Search:
             return (f"multistart: {self.starts} seeded starts{drawn} on the full path ({cap}){stall}{reflect}{held}"
                     f"{solver}")
         capped = f" (at most {self.screen_per_form} of one form)" if self.screen_per_form is not None else ""
+        if self.small_problem_starts > 1:
+            capped += " (a smaller problem's more, on more waypoints, in proportion)"
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
                   f"{self._kkt(self.screen_linear_solver)}, if the path has more)" if self.screen_waypoints else "")

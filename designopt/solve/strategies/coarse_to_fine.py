@@ -14,9 +14,10 @@ design optimal for the full path. Stages, each across every problem:
    (first joints over the whole circle, `Rebranched`), explored alike and pooled with the first round: a start lands in
    the best basin only when its design and its branch both fit, and good designs are where to look for branches.
 2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
-   optima (at most ``screen_per_form`` of one form before other forms, when set) lifted to ``screen_waypoints``
-   waypoints, solved warm within ``screen_max_iter`` and ranked again there: the coarse ranking alone often puts a
-   design that lifts badly ahead of one that lifts well. Once per barrier of ``screen_mu_init`` (stages
+   optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem of several more,
+   on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter``
+   and ranked again there: the coarse ranking alone often puts a design that lifts badly ahead of one that lifts
+   well. Once per barrier of ``screen_mu_init`` (stages
    ``screen``, ``screen2``, ...), each candidate ranked by its better pass.
 3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
@@ -51,9 +52,35 @@ def exploration_starts(problems: list[DesignProblem], search) -> list[int]:
     one's: a small structure, whose starts are cheap and whose basins its `starts` miss, gets more of them."""
     if search.small_problem_starts <= 1:
         return [search.starts] * len(problems)
-    size = [p.chain.n_moving * min(search.explore_waypoints, p.toolpath.n) + p.chain.n_design for p in problems]
+    size = _unknowns(problems, search.explore_waypoints)
     largest = max(size, default=1)
     return [round(search.starts * min(search.small_problem_starts, (largest / n) ** 2)) for n in size]
+
+
+def screening(problems: list[DesignProblem], search) -> list[tuple[int, int | None]]:
+    """(candidates, waypoints) of each problem's screen: ``search.screen`` on ``search.screen_waypoints`` each; with
+    ``search.small_problem_starts`` above 1, a problem explored with more starts (`exploration_starts`) screens as
+    many times more candidates, on as many waypoints w as keep its screen problem the size of the largest one's
+    (m w + d = n_max for m moving and d design joints; at least ``screen_waypoints``; None, the full path, once w
+    reaches the path's count). A small structure's optima often tie on a coarse sampling and part only on the full
+    path (a K = I sweep's RRR: one 20-waypoint optimum lifts to 0.0218 or 0.0243), and its finer screen costs
+    about what the largest structure's screen does."""
+    if search.small_problem_starts <= 1:
+        return [(search.screen, search.screen_waypoints)] * len(problems)
+    largest = max(_unknowns(problems, search.screen_waypoints), default=1)
+    out = []
+    for problem, starts in zip(problems, exploration_starts(problems, search), strict=True):
+        chain = problem.chain
+        waypoints = max(search.screen_waypoints, round((largest - chain.n_design) / max(chain.n_moving, 1)))
+        full = waypoints >= problem.toolpath.n
+        out.append((round(search.screen * starts / search.starts), None if full else waypoints))
+    return out
+
+
+def _unknowns(problems: list[DesignProblem], waypoints: int) -> list[int]:
+    """Each problem's unknowns on (at most) ``waypoints`` of its waypoints: moving joints x waypoints + design
+    joints."""
+    return [p.chain.n_moving * min(waypoints, p.toolpath.n) + p.chain.n_design for p in problems]
 
 
 def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, search, max_iter: int | None = None,
@@ -122,10 +149,10 @@ def plan(jobs, search):
     screened = [k for k, job in enumerate(jobs) if 0 < search.screen_waypoints < job.problem.toolpath.n]
     if screened:
         sub = [jobs[k] for k in screened]
-        tasks = [task for i, screen_mu in enumerate(search.screen_mu_init)
-                 for task in lifted_tasks(sub, [explored[k] for k in screened], search.screen,
-                                          numbered_stage("screen", i), search.screen_waypoints, search,
-                                          search.screen_max_iter, mu_init=screen_mu,
+        screens = screening([job.problem for job in jobs], search)
+        tasks = [task for i, screen_mu in enumerate(search.screen_mu_init) for k in screened
+                 for task in lifted_tasks([jobs[k]], [explored[k]], screens[k][0], numbered_stage("screen", i),
+                                          screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
                                           per_form=search.screen_per_form,
                                           linear_solver=search.screen_linear_solver)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
