@@ -196,7 +196,11 @@ PRESETS: dict[str, Search] = {
     # A structure with fewer joints explores with more starts, about what a 6-joint structure's 40 cost, at most 160
     # (`small_problem_starts`; 5, 4, 3 joints: 56, 84, 139 starts): on fresh K = I seeds 2141 and 2142 (whole
     # sweeps, side by side), references within 1.10x 4 -> 4 and 5 -> 7, structure bests lower / higher by > 1 % 5 / 2
-    # and 8 / 6, at 1.107x and 1.088x the solver time (docs/decisions.md, 2026-11-29)
+    # and 8 / 6, at 1.107x and 1.088x the solver time (docs/decisions.md, 2026-11-29). And screens as many times more
+    # candidates on more waypoints, its screen problem the size of a 6-joint one's (`screening`; 5, 4, 3 joints: 17
+    # on 25, 25 on 32, 42 on the full path): on fresh seeds 2144 and 2145 (replays from the screen on, side by
+    # side), references within 1.10x 6 -> 7 and 7 -> 7, structure bests lower / higher by > 1 % 12 / 6 and 13 / 6,
+    # at 1.021x and 1.028x the sweep's solver time (docs/decisions.md, 2026-11-29)
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
                     explore_linear_solver="ldl", screen_linear_solver="ldl",
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
