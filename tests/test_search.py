@@ -20,6 +20,7 @@ from designopt.config import load_config, parse_config
 from designopt.costs import tracking_residual
 from designopt.experiments.adapters import search_from_config, structure_config
 from designopt.initial_guess import (
+    HOME_PULL,
     _moved_onto_path,
     beyond_reach,
     ik_trajectory,
