@@ -73,7 +73,6 @@ def random_configuration(problem: DesignProblem, rng: np.random.Generator, half_
 
 HOME_PULL = 0.5  # share of the self-motion step towards the home posture an IK iteration of ``init: home`` takes
 HOME_STEP = 0.5  # largest self-motion step of one IK iteration [rad or m, the joints' own units]
-REACH_SLACK = 1.25  # a step up to this many times its reach is not a change of branch (`projected`)
 POLISH = 10  # damped least-squares iterations without the pull that finish a waypoint's IK
 
 
@@ -148,44 +147,32 @@ def projected(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations
     """``Q`` (N x n_moving) moved onto the path with the design ``q_d`` held: at every waypoint a damped
     least-squares IK on the tracking residual (tool position in W [m], tool axis), within the joints' bounds,
     from that waypoint's row of ``Q`` (so that it keeps its branch). Then, from the first waypoint on, a
-    waypoint still further than ``tol`` from its target, or one that no trajectory within `REACH_SLACK` times the
-    velocity limits reaches from the waypoint before it (`beyond_reach`: the IK or ``Q`` changed branch there), is
-    walked to along the path from the waypoint before it: first from there moved by the rows' own step (each
-    joint's step clipped to what it can move in the time), kept if it ends on the path (within ``tol``) within
-    `REACH_SLACK` times the reach; else from the waypoint before it alone, kept if it is nearer the target, or on
-    it and within reach (where the path itself asks for more than the limits allow, the IK's own answer stays).
-    A waypoint's residual never grows above its row's, or above ``tol`` where the step was beyond reach.
-
-    Why the slack and the carried step: a coarse solution sampled between its knots (`lifted_guess`) steps up to
-    about 1.1 times the reach wherever a joint rides its velocity limit, while a change of branch steps several
-    times as far. An arm with self-motion walked from the waypoint before alone stays where that one was on the
-    self-motion while the rows move on, so every later row is walked too and the start drifts off the solution it
-    was lifted from (a K = I sweep's RRRR screen optimum, 0.0101: lifted with a strict reach and walks from the
-    waypoint before, up to 2.9 rad off it and a cost of 0.25; now 0.0105; `docs/decisions.md`)."""
+    waypoint still further than ``tol`` from its target, or one that no trajectory within the velocity limits
+    reaches from the waypoint before it (`beyond_reach`: the IK or ``Q`` changed branch there), starts again
+    from the waypoint before it, as a walk along the path does. The walk is kept if it is nearer the target, or
+    if it is on it (within ``tol``) and within reach where the step was not (where the path itself asks for more
+    than the limits allow, the IK's own answer stays). A waypoint's residual never grows above its row's, or
+    above ``tol`` where the step was beyond reach."""
     Q = np.array(Q, dtype=float)
     everywhere = np.arange(len(Q))
     Q, r = _moved_onto_path(problem, q_d, Q, everywhere, iterations)
-    moves = np.clip(np.diff(Q, axis=0), -problem.max_steps, problem.max_steps)  # each row's own step, within reach
     for k in range(1, len(Q)):
-        if np.linalg.norm(r[k]) <= tol and not beyond_reach(problem, Q[k - 1 : k + 1], k - 1, REACH_SLACK)[0]:
-            continue
-        for start, slack in ((Q[k - 1] + moves[k - 1], REACH_SLACK), (Q[k - 1], 1.0)):
-            walked, r_walked = _moved_onto_path(problem, q_d, start[None, :], everywhere[k : k + 1], iterations)
+        jumped = bool(beyond_reach(problem, Q[k - 1 : k + 1], k - 1)[0])
+        if np.linalg.norm(r[k]) > tol or jumped:
+            walked, r_walked = _moved_onto_path(problem, q_d, Q[k - 1 : k], everywhere[k : k + 1], iterations)
+            nearer = r_walked[0] @ r_walked[0] < r[k] @ r[k]
             reached = np.linalg.norm(r_walked[0]) <= tol and not beyond_reach(problem, np.vstack([Q[k - 1], walked]),
-                                                                             k - 1, slack)[0]
-            if reached:
-                break
-        nearer = r_walked[0] @ r_walked[0] < r[k] @ r[k]
-        if reached or nearer:
-            Q[k], r[k] = walked[0], r_walked[0]
+                                                                             k - 1)[0]
+            if nearer or (jumped and reached):
+                Q[k], r[k] = walked[0], r_walked[0]
     return Q
 
 
-def beyond_reach(problem: DesignProblem, Q: np.ndarray, first: int = 0, slack: float = 1.0) -> np.ndarray:
+def beyond_reach(problem: DesignProblem, Q: np.ndarray, first: int = 0) -> np.ndarray:
     """For each step between rows of ``Q`` (waypoints ``first``, ``first + 1``, ...): is some joint's step
-    longer than it can move in the time between them (`DesignProblem.max_steps`), or than ``slack`` times that?
-    No trajectory the collocation accepts makes such a step. (len(Q) - 1 booleans.)"""
-    return np.any(np.abs(np.diff(Q, axis=0)) > slack * problem.max_steps[first : first + len(Q) - 1], axis=1)
+    longer than it can move in the time between them (`DesignProblem.max_steps`)? No trajectory the collocation
+    accepts makes such a step. (len(Q) - 1 booleans.)"""
+    return np.any(np.abs(np.diff(Q, axis=0)) > problem.max_steps[first : first + len(Q) - 1], axis=1)
 
 
 def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks: np.ndarray, iterations: int):

@@ -20,7 +20,6 @@ from designopt.config import load_config, parse_config
 from designopt.costs import tracking_residual
 from designopt.experiments.adapters import search_from_config, structure_config
 from designopt.initial_guess import (
-    HOME_PULL,
     _moved_onto_path,
     beyond_reach,
     ik_trajectory,
@@ -286,54 +285,6 @@ def test_projection_walks_where_the_ik_would_change_branch(milling_12):
     assert np.all(steps(back) <= np.maximum(steps(first), 1.0) + 1e-9)
     assert np.abs(back - first).max() < 0.2
     assert np.array_equal(back[6:], first[6:])
-
-
-def _riding_the_self_motion(milling_12, turn: float, reach: float):
-    """The 12-waypoint main job's IK trajectory (6R: one self-motion, the last joint's turn about the tool axis)
-    turned on by ``turn`` rad more at every waypoint, on the path, with the velocity limits set so that its
-    longest step is ``reach`` times what they allow: as a coarse solution sampled between its knots moves where a
-    joint rides its limit. Returns (problem, q_d, the trajectory, the untouched IK trajectory)."""
-    cfg = copy.deepcopy(milling_12)
-    problem = problem_from_config(parse_config(cfg))
-    tp, fn = problem.toolpath, residual_function(problem)
-    q_d = np.array([j.value for j in problem.chain.design])
-    Q = ik_trajectory(problem, q_d, np.full(problem.chain.n_moving, 0.3))
-    S, axis = Q.copy(), None
-    for k in range(1, tp.n):  # the IK's own step plus ``turn`` along dr/dq's null space, back onto the path
-        n = np.linalg.svd(np.array(fn(S[k - 1], q_d, tp.points_W[k - 1])[1]))[2][-1]
-        axis = n if axis is None or n @ axis > 0 else -n
-        start = S[k - 1] + (Q[k] - Q[k - 1]) + turn * axis
-        S[k] = _moved_onto_path(problem, q_d, start[None, :], np.array([k]), 30)[0][0]
-    ratio = (np.abs(np.diff(S, axis=0)) / problem.max_steps).max()
-    cfg["robot"]["joint_velocity"] = cfg["robot"]["joint_velocity"] * ratio / reach
-    return problem_from_config(parse_config(cfg)), q_d, S, Q
-
-
-def test_rows_on_the_path_a_hair_beyond_reach_are_not_walked(milling_12):
-    """A trajectory on the path that turns along the arm's self-motion by 1 rad per waypoint, every step 1.05 times
-    what the velocity limits allow: no row changed branch, so `projected` returns every row as it was. Walked from
-    the waypoint before instead, a row would stay where that one was on the self-motion, and so would every row
-    after it (11 rad off at the last; `initial_guess.REACH_SLACK`)."""
-    problem, q_d, S, Q = _riding_the_self_motion(milling_12, 1.0, 1.05)
-    fn = residual_function(problem)
-    assert max(np.linalg.norm(np.array(fn(S[k], q_d, problem.toolpath.points_W[k])[0])) for k in range(len(S))) < 1e-7
-    assert np.abs(S - Q).max() > 10.0 and beyond_reach(problem, S).all()  # the premise
-    assert np.abs(projected(problem, q_d, S) - S).max() < 1e-9
-
-
-def test_a_walk_past_a_change_of_branch_carries_the_rows_own_step(milling_12):
-    """The trajectory above with waypoint 5's first five joints on another IK branch (2.6 rad away): `projected`
-    walks waypoint 5 back to the first branch from waypoint 4 moved by the rows' own step, so it keeps turning
-    with the rows, and every later row stays as it was. Walked from waypoint 4 alone, waypoint 5 would stay where
-    4 was on the self-motion and every later row would follow it (1 to 7 rad off)."""
-    problem, q_d, S, _ = _riding_the_self_motion(milling_12, 1.0, 1.05)
-    other = ik_trajectory(problem, q_d, np.array([0.3, -1.5, 2.0, 0.3, 0.3, 0.3]))
-    mixed = S.copy()
-    mixed[5, :5] = other[5, :5]
-    assert np.abs(mixed[5] - S[5]).max() > 2.0
-    back = projected(problem, q_d, mixed)
-    assert np.abs(back[5] - S[5]).max() < 0.2
-    assert np.array_equal(back[:5], S[:5]) and np.abs(back[6:] - S[6:]).max() < 1e-9
 
 
 @settings(max_examples=40, deadline=None)
