@@ -11,6 +11,7 @@ best, PPP's rank among 3-DOF structures, and the spread (max/min) between runs.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from pathlib import Path
 
@@ -52,6 +53,7 @@ def main(paths: list[str]) -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly, as a shell tool does
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("tables", nargs="+", help="table.csv of each sweep run")
     main(parser.parse_args().tables)
