@@ -190,6 +190,37 @@ def test_modular_command_writes_every_stage(tmp_path):
         assert verify_file(f) == [], f
 
 
+def test_a_rounded_assignment_that_does_not_track_still_gets_the_neighbourhood_search(tmp_path, monkeypatch):
+    """Seed 1101 of the shipped config: none of the rounded assignment's 4 re-solves tracked (IPOPT: infeasible),
+    and the run ended with no modular robot. The neighbourhood search does not need that re-solve: it screens the
+    rounded assignment with its own starts and a sample spread over the catalogue. Here the re-solve is made to
+    find no tracking start; the search still ends at a tracking robot built from catalogue modules."""
+    import json
+
+    from designopt.experiments import modular as experiment
+    from designopt.verify import verify_file
+
+    stage = experiment._stage
+
+    def no_tracking_resolve(setup, problem, case, transcription=None):
+        return None if case == "modular" else stage(setup, problem, case, transcription)
+
+    monkeypatch.setattr(experiment, "_stage", no_tracking_resolve)
+    cfg = parse_config({"name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 12},
+                        "placement": {"xyz": [0.45, 0.0, -0.2]}, "search": {"preset": "paper", "starts": 1}})
+    result = experiment.run_modular(cfg, tmp_path, "t", figures=False, jobs=1, neighbourhood_budget=8,
+                                    neighbourhood_refine=1)
+    table = result.table.set_index("stage")
+    assert not table.loc["modular", "tracks"] and np.isnan(table.loc["modular", "design_cost"])
+    assert table.loc["neighbourhood", "tracks"] and np.isfinite(table.loc["neighbourhood", "design_cost"])
+    summary = pd.read_csv(result.directory.path / "summary.csv")
+    assert summary["case"].str.startswith("sc-").sum() >= 8  # the budget's robots screened
+    modules = {tuple(m) for m in catalogue_from_config(cfg).modules}
+    built = result.directory.path / "best-neighbourhood.json"
+    assert verify_file(built) == []
+    assert all((r["d"], r["a"], r["alpha"]) in modules for r in json.loads(built.read_text())["dh"])
+
+
 def test_mixed_structure_is_a_one_line_error(tmp_path):
     import yaml
     from typer.testing import CliRunner

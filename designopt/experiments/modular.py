@@ -166,7 +166,7 @@ def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progre
     continuous, assignment, modular, placement = _round_and_resolve(s, base, catalogue, weight, "")
     best["continuous_modular"], best["modular"] = continuous, modular
     searched = assignment
-    if modular is not None and neighbourhood_budget:
+    if continuous is not None and neighbourhood_budget:  # also when no start of the rounded assignment tracked
         searched, best["neighbourhood"], screened = _module_search(s, base, catalogue, placement, assignment, modular,
                                                                     neighbourhood_budget, refine=neighbourhood_refine)
         run.log(f"neighbourhood search: {screened} robots screened, best {[k + 1 for k in searched]}")
@@ -247,7 +247,8 @@ def _module_search(setup, base, catalogue, placement, rounded, modular, budget, 
     assignments that build one robot up to a lift along base z are one robot: screened once, solved with the
     placement z any of them could take (`lifted_range`), and reported as the one whose placement lies in the box
     (`within_box`). Returns (best assignment, its solution, robots screened); never worse than the rounded
-    assignment's re-solve ``modular``."""
+    assignment's re-solve ``modular`` (None when none of its starts tracked: then the full-path search may solve the
+    rounded assignment again, if it is among the best screened)."""
     z = base.chain.joint("placement.z")
     absorbed = z.role is Role.DESIGN and lifts_absorbed(catalogue, (z.lower, z.upper))
     same = partial(same_robot, catalogue=catalogue) if absorbed else None
@@ -256,7 +257,8 @@ def _module_search(setup, base, catalogue, placement, rounded, modular, budget, 
     ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget,
                                             round(budget * NEIGHBOURHOOD_SAMPLE), refine, setup.search.seed, same)
     full = ModuleCosts(setup, base, catalogue, placement, "nb-", module_refine(setup.search), absorbed=absorbed)
-    full.best[tuple(rounded)] = modular  # already solved: the modular stage
+    if modular is not None:
+        full.best[tuple(rounded)] = modular  # already solved: the modular stage
     full(ranked)
     solved = {a: sol for a, sol in full.best.items() if sol is not None and sol.metrics.tracks}
     if not solved:
