@@ -85,10 +85,11 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4,
                                              reflect=3, small_problem_starts=4, seed=2, explore_linear_solver="ldl",
-                                             screen_linear_solver="ldl", profile=PRESETS["quick"].profile)
+                                             screen_linear_solver=("ldl", "mumps"), profile=PRESETS["quick"].profile)
     # a stage's own linear solver is named in the search's words, the profile's is not
     quick = PRESETS["quick"].describe()
-    assert "20 waypoints (<= 300 iterations, KKT systems by ldl, if" in quick and quick.count("KKT systems by ldl") == 2
+    assert "20 waypoints (<= 300 iterations, each candidate once with KKT systems by ldl and once by mumps, if" in (
+        quick) and quick.count("KKT systems by ldl") == 2
     assert "re-ranked on 40 waypoints (<= 300 iterations, each from barrier the warm start's and 1e-06, if" in (
         PRESETS["default"].describe())
 
@@ -606,7 +607,7 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     problem = problem_from_config(parse_config(milling_12))
     search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
                     screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),  # rebranch: its own test
-                    explore_linear_solver="ldl", screen_linear_solver="ldl", screen_mu_init=(None, 1e-7),
+                    explore_linear_solver="ldl", screen_linear_solver=("ldl",), screen_mu_init=(None, 1e-7),
                     refine_mu_init=(None, 1e-6))
     done = []
 

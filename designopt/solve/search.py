@@ -44,8 +44,9 @@ class Search:
     the design held there (`strategies.continuation`). ``structure_neighbours``: after the strategy, one more
     start per problem from each neighbouring structure's better design (`strategies.neighbours`; problems whose
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
-    solver profile; ``explore_linear_solver`` and ``screen_linear_solver``: the exploration's and the screen's
-    linear solver instead of the profile's (None: the profile's; `SolverProfile.linear_solver`).
+    solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None: the
+    profile's; `SolverProfile.linear_solver`); ``screen_linear_solver``: the screen's, each candidate screened once
+    by each of them (and each barrier of ``screen_mu_init``: `screen_passes`).
     ``refine_mu_init``: the barrier parameters the refine's warm solves start from (IPOPT's ``mu_init``; None: the
     warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate refined once per value (stages
     ``refine``, ``refine2``, ...; the answer is the best of all): from a small one a refine stays in the basin its
@@ -83,7 +84,7 @@ class Search:
     structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
     explore_linear_solver: str | None = None
-    screen_linear_solver: str | None = None
+    screen_linear_solver: tuple[str | None, ...] = (None,)
     screen_mu_init: tuple[float | None, ...] = (None,)
     refine_mu_init: tuple[float | None, ...] = (None,)
     reflect: int = 0
@@ -105,6 +106,12 @@ class Search:
         on a new joint branch: its index (`initial_guess.start_index`) from ``most_starts`` on
         (`rebranched_tasks`)."""
         return start_index(number, self.seed) >= self.most_starts
+
+    @property
+    def screen_passes(self) -> list[tuple[float | None, str | None]]:
+        """The screen's passes, (barrier, linear solver) each: every barrier of ``screen_mu_init`` by every linear
+        solver of ``screen_linear_solver``, barriers outer; pass i is stage `numbered_stage("screen", i)`."""
+        return [(mu, solver) for mu in self.screen_mu_init for solver in self.screen_linear_solver]
 
     def describe(self) -> str:
         """The search in words."""
@@ -129,7 +136,7 @@ class Search:
             capped += " (a smaller problem's more, on more waypoints, in proportion)"
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
-                  f"{self._kkt(self.screen_linear_solver)}, if the path has more)" if self.screen_waypoints else "")
+                  f"{self._kkts(self.screen_linear_solver)}, if the path has more)" if self.screen_waypoints else "")
         per_form = (f" (at most {self.rebranch_per_form} of one form)" if self.rebranch_per_form is not None
                     else "")
         if self.rebranch_new_forms:
@@ -149,6 +156,14 @@ class Search:
         """A stage's linear solver in words, where it is not the profile's."""
         kkt = linear_solver or self.profile.linear_solver
         return f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
+
+
+    def _kkts(self, linear_solvers: tuple[str | None, ...]) -> str:
+        """A stage's linear solvers in words: one as `_kkt`; several, each candidate solved by each."""
+        if len(linear_solvers) == 1:
+            return self._kkt(linear_solvers[0])
+        names = " and once by ".join(solver or self.profile.linear_solver for solver in linear_solvers)
+        return f", each candidate once with KKT systems by {names}"
 
 
 def _barriers(mu_init: tuple[float | None, ...]) -> str:
@@ -202,7 +217,7 @@ PRESETS: dict[str, Search] = {
     # side), references within 1.10x 6 -> 7 and 7 -> 7, structure bests lower / higher by > 1 % 12 / 6 and 13 / 6,
     # at 1.021x and 1.028x the sweep's solver time (docs/decisions.md, 2026-11-29)
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
-                    explore_linear_solver="ldl", screen_linear_solver="ldl",
+                    explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"),
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
     # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against
