@@ -598,16 +598,16 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
 
 
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
-    """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter (and
-    with screen_linear_solver), refinement within the profile's max_iter (screen and refine once from each barrier
-    of screen_mu_init and refine_mu_init): a screening solve only ranks, so a stalling one must not take the full
+    """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter (once
+    by each of screen_linear_solver and from each barrier of screen_mu_init), refinement within the profile's
+    max_iter (once from each barrier of refine_mu_init): a screening solve only ranks, so a stalling one must not take the full
     budget (design only stalls there). The caps are read off the tasks each stage was given, so the test does not
     depend on which solve reaches its cap; the screen's cap is loose enough that its optima track and a refine
     follows."""
     problem = problem_from_config(parse_config(milling_12))
     search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
                     screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),  # rebranch: its own test
-                    explore_linear_solver="ldl", screen_linear_solver=("ldl",), screen_mu_init=(None, 1e-7),
+                    explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), screen_mu_init=(None, 1e-7),
                     refine_mu_init=(None, 1e-6))
     done = []
 
@@ -616,30 +616,33 @@ def test_each_stage_keeps_its_own_iteration_cap(milling_12):
         return done[-len(tasks):]
 
     run_search([Job("", problem)], search, execute)
-    caps = {"explore": 100, "screen": 150, "screen2": 150, "refine": 300, "refine2": 300}
+    screens = ("screen", "screen2", "screen3", "screen4")
+    caps = {"explore": 100, **dict.fromkeys(screens, 150), "refine": 300, "refine2": 300}
     assert {t.stage for t, _ in done} == set(caps)
     for stage, cap in caps.items():
         assert all(t.profile.max_iter == cap for t, _ in done if t.stage == stage)
         assert max(s.raw.iterations for t, s in done if t.stage == stage) <= cap
     waypoints = {t.stage: t.problem.toolpath.n for t, _ in done}
-    assert waypoints == {"explore": 6, "screen": 9, "screen2": 9, "refine": 12, "refine2": 12}
-    solvers = {t.stage: t.profile.linear_solver for t, _ in done}  # the exploration and the screen their own
-    assert solvers == {"explore": "ldl", "screen": "ldl", "screen2": "ldl", "refine": "mumps", "refine2": "mumps"}
-    # each candidate screened once per screen barrier (the warm start's own, then 1e-7) and refined once per refine
-    # barrier (the warm start's own, then 1e-6)
+    assert waypoints == {"explore": 6, **dict.fromkeys(screens, 9), "refine": 12, "refine2": 12}
+    # the exploration and the screen their own linear solvers; each candidate screened once per screen barrier (the
+    # warm start's own, then 1e-7) by each screen solver, and refined once per refine barrier (the warm start's
+    # own, then 1e-6)
+    solvers = {t.stage: t.profile.linear_solver for t, _ in done}
+    assert solvers == {"explore": "ldl", "screen": "ldl", "screen2": "mumps", "screen3": "ldl", "screen4": "mumps",
+                       "refine": "mumps", "refine2": "mumps"}
     barriers = {t.stage: dict(t.profile.options).get("ipopt.mu_init") for t, _ in done}
-    assert barriers == {"explore": None, "screen": None, "screen2": 1e-7, "refine": None, "refine2": 1e-6}
-    starts = {stage: sorted(t.seed for t, _ in done if t.stage == stage)
-              for stage in ("screen", "screen2", "refine", "refine2")}
+    assert barriers == {"explore": None, "screen": None, "screen2": None, "screen3": 1e-7, "screen4": 1e-7,
+                        "refine": None, "refine2": 1e-6}
+    starts = {stage: sorted(t.seed for t, _ in done if t.stage == stage) for stage in (*screens, "refine", "refine2")}
     # as many candidates as the exploration found distinct tracking optima, up to 3 (its 4 starts end in 2 or 3
     # distinct optima, depending on the machine's libm: the solves are chaotic in their last bits)
     explored = [(t, s) for t, s in done if t.stage == "explore"]
     candidates = distinct_best([s for _, s in explored], search.screen, search.distinct)
-    assert starts["screen"] == starts["screen2"] == sorted(explored[i][0].seed for i in candidates)
+    assert all(starts[stage] == sorted(explored[i][0].seed for i in candidates) for stage in screens)
     assert len(candidates) >= 2
     assert starts["refine"] == starts["refine2"] and len(starts["refine"]) == 1
-    # the refines start from the cheapest of every screened solve, from either barrier
-    screened = [s for t, s in done if t.stage in ("screen", "screen2") and s.metrics.tracks]
+    # the refines start from the cheapest of every screened solve, from any pass
+    screened = [s for t, s in done if t.stage in screens and s.metrics.tracks]
     cheapest = min(screened, key=lambda s: s.metrics.design_cost)
     assert all(t.start.solution is cheapest for t, _ in done if t.stage in ("refine", "refine2"))
     assert all(t.profile.warm for t, _ in done if t.stage != "explore")
