@@ -600,10 +600,10 @@ def test_the_second_round_restarts_the_best_optima_on_new_branches(milling_12):
 def test_each_stage_keeps_its_own_iteration_cap(milling_12):
     """Exploration within explore_max_iter (and with explore_linear_solver), screening within screen_max_iter (once
     by each of screen_linear_solver and from each barrier of screen_mu_init), refinement within the profile's
-    max_iter (once from each barrier of refine_mu_init): a screening solve only ranks, so a stalling one must not take the full
-    budget (design only stalls there). The caps are read off the tasks each stage was given, so the test does not
-    depend on which solve reaches its cap; the screen's cap is loose enough that its optima track and a refine
-    follows."""
+    max_iter (once from each barrier of refine_mu_init): a screening solve only ranks, so a stalling one must not
+    take the full budget (design only stalls there). The caps are read off the tasks each stage was given, so the
+    test does not depend on which solve reaches its cap; the screen's cap is loose enough that its optima track and
+    a refine follows."""
     problem = problem_from_config(parse_config(milling_12))
     search = Search(starts=4, explore_waypoints=6, explore_max_iter=100, rebranch=0, screen_waypoints=9, screen=3,
                     screen_max_iter=150, refine=1, profile=SolverProfile(max_iter=300),  # rebranch: its own test

@@ -207,7 +207,11 @@ PRESETS: dict[str, Search] = {
     # (docs/decisions.md, "Speed"). The screen's too (20 waypoints, below the LDLᵀ's MATCHED_FROM; the refine's 40
     # gain nothing): on fresh seeds 2130 and 2131 (replays from the screen on, side by side) the screen's solver time
     # 0.69x, the replayed stages' 0.894x both, structure bests lower / higher by > 1 % 9 / 12 and 19 / 7, references
-    # within 1.10x 4 -> 4 and 4 -> 5 (docs/decisions.md, "Speed")
+    # within 1.10x 4 -> 4 and 4 -> 5 (docs/decisions.md, "Speed"). And each candidate screened a second time, by
+    # MUMPS, ranked for the refine by its better pass (the two factorisations lead a screen into different basins,
+    # either way round): on fresh seeds 2151 and 2152 (replays from the screen on), references within 1.10x 5 -> 5 and
+    # 7 -> 8, structure bests lower / higher by > 1 % 13 / 6 and 6 / 11, at 1.16x and 1.14x the sweep's solver time
+    # (docs/decisions.md, 2026-11-30)
     # A structure with fewer joints explores with more starts, about what a 6-joint structure's 40 cost, at most 160
     # (`small_problem_starts`; 5, 4, 3 joints: 56, 84, 139 starts): on fresh K = I seeds 2141 and 2142 (whole
     # sweeps, side by side), references within 1.10x 4 -> 4 and 5 -> 7, structure bests lower / higher by > 1 % 5 / 2
