@@ -72,9 +72,10 @@ def stage_tasks(run: Path, stage: str) -> tuple[list, object]:
     job = Job("", problem_from_config(cfg))
     if stage == "screen":
         found = solved(run, job, "explore", search.explore_waypoints)
-        return [t for i, mu in enumerate(search.screen_mu_init)
+        return [t for i, (mu, solver) in enumerate(search.screen_passes)
                 for t in lifted_tasks([job], [found], search.screen, numbered_stage("screen", i),
-                                      search.screen_waypoints, search, search.screen_max_iter, mu_init=mu)], search
+                                      search.screen_waypoints, search, search.screen_max_iter, mu_init=mu,
+                                      linear_solver=solver)], search
     found = better_pass(solved(run, job, "screen", search.screen_waypoints))
     return [t for i, mu in enumerate(search.refine_mu_init)
             for t in lifted_tasks([job], [found], search.refine, numbered_stage("refine", i), None, search,

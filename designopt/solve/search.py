@@ -136,14 +136,14 @@ class Search:
             capped += " (a smaller problem's more, on more waypoints, in proportion)"
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
-                  f"{self._kkts(self.screen_linear_solver)}, if the path has more)" if self.screen_waypoints else "")
+                  f"{self._kkt(self.screen_linear_solver)}, if the path has more)" if self.screen_waypoints else "")
         per_form = (f" (at most {self.rebranch_per_form} of one form)" if self.rebranch_per_form is not None
                     else "")
         if self.rebranch_new_forms:
             per_form += f" and the best of up to {self.rebranch_new_forms} forms not among them"
         again = (f", the best {self.rebranch} distinct{per_form} restarted {self.rebranch_starts} times each on a "
                  f"new joint branch" if self.rebranch else "")
-        kkt = self._kkt(self.explore_linear_solver)
+        kkt = self._kkt((self.explore_linear_solver,))
         barrier = _barriers(self.refine_mu_init)
         if self.small_problem_starts > 1:
             drawn += (f" (a problem smaller than the largest up to {self.small_problem_starts:g}x as many, "
@@ -152,18 +152,13 @@ class Search:
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){reflect}{held}{solver}")
 
-    def _kkt(self, linear_solver: str | None) -> str:
-        """A stage's linear solver in words, where it is not the profile's."""
-        kkt = linear_solver or self.profile.linear_solver
-        return f", KKT systems by {kkt}" if kkt != self.profile.linear_solver else ""
-
-
-    def _kkts(self, linear_solvers: tuple[str | None, ...]) -> str:
-        """A stage's linear solvers in words: one as `_kkt`; several, each candidate solved by each."""
-        if len(linear_solvers) == 1:
-            return self._kkt(linear_solvers[0])
-        names = " and once by ".join(solver or self.profile.linear_solver for solver in linear_solvers)
-        return f", each candidate once with KKT systems by {names}"
+    def _kkt(self, linear_solvers: tuple[str | None, ...]) -> str:
+        """A stage's linear solvers in words (None: the profile's): one, only where it is not the profile's; several,
+        each candidate solved once by each."""
+        names = [solver or self.profile.linear_solver for solver in linear_solvers]
+        if len(names) > 1:
+            return f", each candidate once with KKT systems by {' and once by '.join(names)}"
+        return f", KKT systems by {names[0]}" if names[0] != self.profile.linear_solver else ""
 
 
 def _barriers(mu_init: tuple[float | None, ...]) -> str:

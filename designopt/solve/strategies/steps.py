@@ -28,6 +28,6 @@ def seeded_tasks(job: Job, stage: str, problem, profile, search: Search, count: 
 
 
 def numbered_stage(stage: str, i: int) -> str:
-    """The name of a stage's ``i``-th pass (0-based): screen, screen2, ... (one per barrier of `Search.screen_mu_init`
-    or `Search.refine_mu_init`); reflect, reflect2, ... (rounds); neighbour, neighbour2, ... (passes)."""
+    """The name of a stage's ``i``-th pass (0-based): screen, screen2, ... (one per `Search.screen_passes` or barrier
+    of `Search.refine_mu_init`); reflect, reflect2, ... (rounds); neighbour, neighbour2, ... (passes)."""
     return stage if i == 0 else f"{stage}{i + 1}"
