@@ -85,11 +85,12 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4,
                                              reflect=3, small_problem_starts=4, seed=2, explore_linear_solver="ldl",
-                                             screen_linear_solver=("ldl", "mumps"), profile=PRESETS["quick"].profile)
+                                             screen_linear_solver=("ldl", "mumps"), screen_repeat_min_joints=5,
+                                             profile=PRESETS["quick"].profile)
     # a stage's own linear solver is named in the search's words, the profile's is not
     quick = PRESETS["quick"].describe()
-    assert "20 waypoints (<= 300 iterations, each candidate once with KKT systems by ldl and once by mumps, if" in (
-        quick) and quick.count("KKT systems by ldl") == 2
+    assert ("20 waypoints (<= 300 iterations, each candidate once with KKT systems by ldl and once by mumps; an arm of "
+            "fewer than 5 joints the first pass only, if") in quick and quick.count("KKT systems by ldl") == 2
     assert "re-ranked on 40 waypoints (<= 300 iterations, each from barrier the warm start's and 1e-06, if" in (
         PRESETS["default"].describe())
 
@@ -489,6 +490,37 @@ def test_a_smaller_problem_of_a_batch_is_screened_on_more_candidates_and_waypoin
     assert {t.problem.toolpath.n for t in screen if t.case == "a"} == {40}
     assert {t.problem.toolpath.n for t in screen if t.case == "b"} == {20}
     assert [t.start.solution for t in screen if t.case == "a"] == sols[:42]  # the cheapest distinct, in order
+
+
+def test_the_screens_later_passes_are_for_arms_of_enough_joints():
+    """`Search.screen_repeat_min_joints`: the screen's passes after the first (here the second linear solver) only
+    for a problem whose arm has at least that many moving joints; a smaller arm is screened once, by the first
+    pass's solver, on the same candidates. 0 (the default): every problem every pass. Driven through the plan: the
+    explored solves in, each job's screen tasks out."""
+    sweep = load_config(Path(__file__).parent.parent / "configs" / "structures.yaml")
+    rrrr, six = (problem_from_config(structure_config(sweep, s)) for s in ("RRRR", "RRRRRR"))
+    both = Search(starts=6, rebranch=0, screen=3, screen_waypoints=20, screen_linear_solver=("ldl", "mumps"))
+
+    def screened(search):
+        plan = coarse_to_fine.plan([Job("a", rrrr), Job("b", six)], search)
+        explore = next(plan)
+        sols = [_optimum(t.problem, float(k), (0,) * int(form_joints(t.problem.chain).sum()), 0.05 * k)
+                for k, t in enumerate(explore)]
+        return {(t.case, t.stage, t.profile.linear_solver, t.start.solution.metrics.design_cost)
+                for t in plan.send(list(zip(explore, sols, strict=True)))}
+
+    every = screened(both)
+    assert {(case, stage, solver) for case, stage, solver, _ in every} == {
+        (case, stage, solver) for case in "ab" for stage, solver in (("screen", "ldl"), ("screen2", "mumps"))}
+    assert len(every) == 4 * 3
+    five = screened(replace(both, screen_repeat_min_joints=5))
+    assert five == {t for t in every if t[0] == "b" or t[1] == "screen"}  # RRRR: the first pass, same candidates
+    assert screened(replace(both, screen_repeat_min_joints=4)) == every
+    assert both.passes_for(1) == both.screen_passes == [(None, "ldl"), (None, "mumps")]
+    assert replace(both, screen_repeat_min_joints=5).passes_for(4) == [(None, "ldl")]
+    assert "fewer than 5 joints the first pass only" in replace(both, screen_repeat_min_joints=5).describe()
+    assert "first pass only" not in both.describe()
+    assert "first pass only" not in replace(both, screen_linear_solver=("ldl",), screen_repeat_min_joints=5).describe()
 
 
 def test_the_screen_takes_at_most_screen_per_form_of_one_form():

@@ -46,7 +46,9 @@ class Search:
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
     solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None: the
     profile's; `SolverProfile.linear_solver`); ``screen_linear_solver``: the screen's, each candidate screened once
-    by each of them (and each barrier of ``screen_mu_init``: `screen_passes`).
+    by each of them (and each barrier of ``screen_mu_init``: `screen_passes`); ``screen_repeat_min_joints``: the
+    screen's passes after the first only for a problem whose arm has at least this many moving joints (a smaller
+    arm's passes end in one basin: screened once, `passes_for`); 0: every problem every pass.
     ``refine_mu_init``: the barrier parameters the refine's warm solves start from (IPOPT's ``mu_init``; None: the
     warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate refined once per value (stages
     ``refine``, ``refine2``, ...; the answer is the best of all): from a small one a refine stays in the basin its
@@ -86,6 +88,7 @@ class Search:
     explore_linear_solver: str | None = None
     screen_linear_solver: tuple[str | None, ...] = (None,)
     screen_mu_init: tuple[float | None, ...] = (None,)
+    screen_repeat_min_joints: int = 0
     refine_mu_init: tuple[float | None, ...] = (None,)
     reflect: int = 0
     small_problem_starts: float = 1.0
@@ -113,6 +116,12 @@ class Search:
         solver of ``screen_linear_solver``, barriers outer; pass i is stage `numbered_stage("screen", i)`."""
         return [(mu, solver) for mu in self.screen_mu_init for solver in self.screen_linear_solver]
 
+    def passes_for(self, moving_joints: int) -> list[tuple[float | None, str | None]]:
+        """The screen's passes for an arm of ``moving_joints`` moving joints: every one of `screen_passes`, or only
+        the first when the arm has fewer than ``screen_repeat_min_joints``."""
+        passes = self.screen_passes
+        return passes if moving_joints >= self.screen_repeat_min_joints else passes[:1]
+
     def describe(self) -> str:
         """The search in words."""
         held = "; a solve stalled on a degenerate design is finished held" if self.hold_degenerate else ""
@@ -136,7 +145,8 @@ class Search:
             capped += " (a smaller problem's more, on more waypoints, in proportion)"
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
-                  f"{self._kkt(self.screen_linear_solver)}, if the path has more)" if self.screen_waypoints else "")
+                  f"{self._kkt(self.screen_linear_solver)}{self._repeated()}, if the path has more)"
+                  if self.screen_waypoints else "")
         per_form = (f" (at most {self.rebranch_per_form} of one form)" if self.rebranch_per_form is not None
                     else "")
         if self.rebranch_new_forms:
@@ -151,6 +161,12 @@ class Search:
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){reflect}{held}{solver}")
+
+    def _repeated(self) -> str:
+        """Which arms the screen's passes after the first are for, in words (`passes_for`)."""
+        if len(self.screen_passes) < 2 or self.screen_repeat_min_joints <= 0:
+            return ""
+        return f"; an arm of fewer than {self.screen_repeat_min_joints} joints the first pass only"
 
     def _kkt(self, linear_solvers: tuple[str | None, ...]) -> str:
         """A stage's linear solvers in words (None: the profile's): one, only where it is not the profile's; several,
@@ -216,7 +232,7 @@ PRESETS: dict[str, Search] = {
     # side), references within 1.10x 6 -> 7 and 7 -> 7, structure bests lower / higher by > 1 % 12 / 6 and 13 / 6,
     # at 1.021x and 1.028x the sweep's solver time (docs/decisions.md, 2026-11-29)
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
-                    explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"),
+                    explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), screen_repeat_min_joints=5,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
     # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against

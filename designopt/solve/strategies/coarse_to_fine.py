@@ -18,7 +18,8 @@ design optimal for the full path. Stages, each across every problem:
    on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter``
    and ranked again there: the coarse ranking alone often puts a design that lifts badly ahead of one that lifts
    well. Once per barrier of ``screen_mu_init`` and linear solver of ``screen_linear_solver`` (stages ``screen``,
-   ``screen2``, ...: `Search.screen_passes`), each candidate ranked by its better pass.
+   ``screen2``, ...: `Search.screen_passes`; an arm with fewer than ``screen_repeat_min_joints`` joints the first
+   pass only), each candidate ranked by its better pass.
 3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
    once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
@@ -151,6 +152,7 @@ def plan(jobs, search):
         sub = [jobs[k] for k in screened]
         screens = screening([job.problem for job in jobs], search)
         tasks = [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
+                 if i < len(search.passes_for(jobs[k].problem.chain.n_moving))
                  for task in lifted_tasks([jobs[k]], [explored[k]], screens[k][0], numbered_stage("screen", i),
                                           screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
                                           per_form=search.screen_per_form, linear_solver=solver)]
