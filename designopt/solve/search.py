@@ -222,7 +222,10 @@ PRESETS: dict[str, Search] = {
     # MUMPS, ranked for the refine by its better pass (the two factorisations lead a screen into different basins,
     # either way round): on fresh seeds 2151 and 2152 (replays from the screen on), references within 1.10x 5 -> 5 and
     # 7 -> 8, structure bests lower / higher by > 1 % 13 / 6 and 6 / 11, at 1.16x and 1.14x the sweep's solver time
-    # (docs/decisions.md, 2026-11-30)
+    # (docs/decisions.md, 2026-11-30); the second pass only where the arm has 5 or more joints (the 3- and 4-joint
+    # structures' passes end alike): on fresh seeds 2154 and 2155 (replays from the refine on) the same references,
+    # structure bests lower / higher by > 1 % 0 / 0 and 0 / 1, at 0.93x the sweep's solver time (docs/decisions.md,
+    # 2026-11-30)
     # A structure with fewer joints explores with more starts, about what a 6-joint structure's 40 cost, at most 160
     # (`small_problem_starts`; 5, 4, 3 joints: 56, 84, 139 starts): on fresh K = I seeds 2141 and 2142 (whole
     # sweeps, side by side), references within 1.10x 4 -> 4 and 5 -> 7, structure bests lower / higher by > 1 % 5 / 2
