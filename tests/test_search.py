@@ -86,7 +86,7 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4,
                                              reflect=3, small_problem_starts=4, seed=2, explore_linear_solver="ldl",
                                              screen_linear_solver=("ldl", "mumps"), screen_repeat_min_joints=5,
-                                             profile=PRESETS["quick"].profile)
+                                             small_arm_perturbation=0.6, profile=PRESETS["quick"].profile)
     # a stage's own linear solver is named in the search's words, the profile's is not
     quick = PRESETS["quick"].describe()
     assert ("20 waypoints (<= 300 iterations, each candidate once with KKT systems by ldl and once by mumps; an arm of "
@@ -521,6 +521,30 @@ def test_the_screens_later_passes_are_for_arms_of_enough_joints():
     assert "fewer than 5 joints the first pass only" in replace(both, screen_repeat_min_joints=5).describe()
     assert "first pass only" not in both.describe()
     assert "first pass only" not in replace(both, screen_linear_solver=("ldl",), screen_repeat_min_joints=5).describe()
+
+
+def test_an_arm_of_fewer_than_five_joints_explores_from_wider_starts():
+    """`Search.small_arm_perturbation`: the exploration's seeded starts of an arm with fewer than `SMALL_ARM` (5)
+    moving joints are perturbed by it, a larger arm's by ``perturbation``; None (the default): every arm by
+    ``perturbation``. A wider start is a different design: start 1 of RRRR moves from the configured design twice
+    as far, the same draw, wherever neither start is clipped to a bound."""
+    sweep = load_config(Path(__file__).parent.parent / "configs" / "structures.yaml")
+    rrrr, rrrrr = (problem_from_config(structure_config(sweep, s)) for s in ("RRRR", "RRRRR"))
+    wide = Search(starts=3, rebranch=0, small_arm_perturbation=0.6)
+    explore = next(coarse_to_fine.plan([Job("a", rrrr), Job("b", rrrrr)], wide))
+    assert {(t.case, t.start.scale) for t in explore} == {("a", 0.6), ("b", 0.3)}
+    plain = next(coarse_to_fine.plan([Job("a", rrrr), Job("b", rrrrr)], Search(starts=3, rebranch=0)))
+    assert {t.start.scale for t in plain} == {0.3}
+    assert (wide.perturbation_for(4), wide.perturbation_for(5), Search().perturbation_for(1)) == (0.6, 0.3, 0.3)
+    # the same draw, twice as far from the configured design wherever neither start is clipped to a bound
+    home = rrrr.chain.design_values
+    lo, hi = np.array([(j.lower, j.upper) for j in rrrr.chain.design]).T
+    far, near = (t.start.guess(t.problem).q_d for t in (explore[1], plain[1]))
+    inside = (lo < far) & (far < hi) & (lo < near) & (near < hi)
+    assert inside.sum() >= len(home) // 2
+    assert np.allclose((far - home)[inside], 2 * (near - home)[inside], rtol=1e-9, atol=1e-12)
+    assert "fewer than 5 joints perturbed by 0.6" in wide.describe()
+    assert "perturbed by" not in Search().describe()
 
 
 def test_the_screen_takes_at_most_screen_per_form_of_one_form():

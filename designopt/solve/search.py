@@ -21,6 +21,10 @@ from designopt.solve.profile import SolverProfile
 from designopt.solve.tasks import Task
 from designopt.transcriptions import Collocation
 
+SMALL_ARM = 5
+"""Moving joints below which an arm cannot track the path's 5 degrees of freedom (the tool's position and its axis's
+direction; its spin is free) on a general design: its designs are structural, often far from a generic start."""
+
 
 @dataclass(frozen=True)
 class Search:
@@ -49,6 +53,8 @@ class Search:
     by each of them (and each barrier of ``screen_mu_init``: `screen_passes`); ``screen_repeat_min_joints``: the
     screen's passes after the first only for a problem whose arm has at least this many moving joints (a smaller
     arm's passes end in one basin: screened once, `passes_for`); 0: every problem every pass.
+    ``small_arm_perturbation``: the ``perturbation`` of the exploration's seeded starts of an arm with fewer than
+    `SMALL_ARM` moving joints (None: ``perturbation``; `perturbation_for`).
     ``refine_mu_init``: the barrier parameters the refine's warm solves start from (IPOPT's ``mu_init``; None: the
     warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate refined once per value (stages
     ``refine``, ``refine2``, ...; the answer is the best of all): from a small one a refine stays in the basin its
@@ -89,6 +95,7 @@ class Search:
     screen_linear_solver: tuple[str | None, ...] = (None,)
     screen_mu_init: tuple[float | None, ...] = (None,)
     screen_repeat_min_joints: int = 0
+    small_arm_perturbation: float | None = None
     refine_mu_init: tuple[float | None, ...] = (None,)
     reflect: int = 0
     small_problem_starts: float = 1.0
@@ -116,6 +123,13 @@ class Search:
         solver of ``screen_linear_solver``, barriers outer; pass i is stage `numbered_stage("screen", i)`."""
         return [(mu, solver) for mu in self.screen_mu_init for solver in self.screen_linear_solver]
 
+    def perturbation_for(self, moving_joints: int) -> float:
+        """The seeded starts' perturbation for an arm of ``moving_joints`` moving joints: ``small_arm_perturbation``
+        below `SMALL_ARM` joints, when set, else ``perturbation``."""
+        if self.small_arm_perturbation is not None and moving_joints < SMALL_ARM:
+            return self.small_arm_perturbation
+        return self.perturbation
+
     def passes_for(self, moving_joints: int) -> list[tuple[float | None, str | None]]:
         """The screen's passes for an arm of ``moving_joints`` moving joints: every one of `screen_passes`, or only
         the first when the arm has fewer than ``screen_repeat_min_joints``."""
@@ -132,6 +146,8 @@ class Search:
         cap = f"<= {self.profile.max_iter} iterations"
         drawn = {"perturb": "", "box": " drawn from the task's box",
                  "mixed": " (every other one drawn from the task's box)"}[self.spread]
+        if self.small_arm_perturbation is not None:
+            drawn += f" (an arm of fewer than {SMALL_ARM} joints perturbed by {self.small_arm_perturbation:g})"
         if self.init == "home":
             drawn += " (their IK walks pulled towards the first waypoint's configuration)"
         reflect = (f", then the best reflected across its length bounds (up to {self.reflect} rounds)" if self.reflect
@@ -225,7 +241,10 @@ PRESETS: dict[str, Search] = {
     # (docs/decisions.md, 2026-11-30); the second pass only where the arm has 5 or more joints (the 3- and 4-joint
     # structures' passes end alike): on fresh seeds 2154 and 2155 (replays from the refine on) the same references,
     # structure bests lower / higher by > 1 % 0 / 0 and 0 / 1, at 0.93x the sweep's solver time (docs/decisions.md,
-    # 2026-11-30)
+    # 2026-11-30). An arm of fewer than 5 joints explores from starts perturbed by 0.6 (its designs are structural and
+    # far from the generic one: RRPR's best has links of 1.5-1.9 m): on seeds 2154 and 2155 (replays, not tuned on)
+    # references within 1.10x 5 -> 6 and 7 -> 7, structure bests lower / higher by > 1 % 5 / 1 and 4 / 3, at 1.00x and
+    # 1.03x the solver time (docs/decisions.md, 2026-11-30)
     # A structure with fewer joints explores with more starts, about what a 6-joint structure's 40 cost, at most 160
     # (`small_problem_starts`; 5, 4, 3 joints: 56, 84, 139 starts): on fresh K = I seeds 2141 and 2142 (whole
     # sweeps, side by side), references within 1.10x 4 -> 4 and 5 -> 7, structure bests lower / higher by > 1 % 5 / 2
@@ -236,6 +255,7 @@ PRESETS: dict[str, Search] = {
     # at 1.021x and 1.028x the sweep's solver time (docs/decisions.md, 2026-11-29)
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
                     explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), screen_repeat_min_joints=5,
+                    small_arm_perturbation=0.6,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
     # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against

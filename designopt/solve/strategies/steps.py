@@ -23,7 +23,8 @@ def seeded_tasks(job: Job, stage: str, problem, profile, search: Search, count: 
     """``count`` seeded starts of ``problem`` (the job's, or a coarser sampling of it)."""
     profile, continuation = solve_setup(job, search, profile)
     return [Task(job.case, stage, problem, job.transcription, profile,
-                 Seeded(search.seed, i, search.perturbation, search.init, spread=search.spread), continuation)
+                 Seeded(search.seed, i, search.perturbation_for(job.problem.chain.n_moving), search.init,
+                        spread=search.spread), continuation)
             for i in range(count)]
 
 
