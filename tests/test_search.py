@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import yaml
 from conftest import solve
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from designopt.config import load_config, parse_config
@@ -741,6 +741,7 @@ def test_the_refine_ranks_every_screen_pass_together(milling_12):
 
 @settings(max_examples=60, deadline=None)
 @given(starts=st.lists(st.integers(1, 12), min_size=1, max_size=12), workers=st.integers(1, 4))
+@example(starts=[12], workers=1)  # one problem whose starts a piecewise split would cut (12 // 4 = 3 a unit)
 def test_a_problems_starts_go_to_few_workers(starts, workers):
     """`units`: every task dispatched exactly once, in its order; a unit holds one problem's starts only; with
     several problems, starts are grouped in pieces of at most a quarter of a worker's share, cut only where that
