@@ -85,7 +85,7 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert "every other one drawn from the task's box" in replace(PRESETS["paper"], spread="mixed").describe()
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4,
                                              reflect=3, small_problem_starts=4, seed=2, explore_linear_solver="ldl",
-                                             screen_linear_solver=("ldl", "mumps"), screen_repeat_min_joints=5,
+                                             screen_linear_solver=("ldl", "mumps"), small_arm_screens_once=True,
                                              small_arm_perturbation=0.6, profile=PRESETS["quick"].profile)
     # a stage's own linear solver is named in the search's words, the profile's is not
     quick = PRESETS["quick"].describe()
@@ -492,11 +492,11 @@ def test_a_smaller_problem_of_a_batch_is_screened_on_more_candidates_and_waypoin
     assert [t.start.solution for t in screen if t.case == "a"] == sols[:42]  # the cheapest distinct, in order
 
 
-def test_the_screens_later_passes_are_for_arms_of_enough_joints():
-    """`Search.screen_repeat_min_joints`: the screen's passes after the first (here the second linear solver) only
-    for a problem whose arm has at least that many moving joints; a smaller arm is screened once, by the first
-    pass's solver, on the same candidates. 0 (the default): every problem every pass. Driven through the plan: the
-    explored solves in, each job's screen tasks out."""
+def test_the_screens_later_passes_are_for_arms_of_five_joints_or_more():
+    """`Search.small_arm_screens_once`: the screen's passes after the first (here the second linear solver) only
+    for a problem whose arm has at least `SMALL_ARM` (5) moving joints; a smaller arm is screened once, by the first
+    pass's solver, on the same candidates. False (the default): every problem every pass. Driven through the plan:
+    the explored solves in, each job's screen tasks out."""
     sweep = load_config(Path(__file__).parent.parent / "configs" / "structures.yaml")
     rrrr, six = (problem_from_config(structure_config(sweep, s)) for s in ("RRRR", "RRRRRR"))
     both = Search(starts=6, rebranch=0, screen=3, screen_waypoints=20, screen_linear_solver=("ldl", "mumps"))
@@ -513,14 +513,14 @@ def test_the_screens_later_passes_are_for_arms_of_enough_joints():
     assert {(case, stage, solver) for case, stage, solver, _ in every} == {
         (case, stage, solver) for case in "ab" for stage, solver in (("screen", "ldl"), ("screen2", "mumps"))}
     assert len(every) == 4 * 3
-    five = screened(replace(both, screen_repeat_min_joints=5))
-    assert five == {t for t in every if t[0] == "b" or t[1] == "screen"}  # RRRR: the first pass, same candidates
-    assert screened(replace(both, screen_repeat_min_joints=4)) == every
+    once = replace(both, small_arm_screens_once=True)
+    # RRRR: the first pass only, on the same candidates
+    assert screened(once) == {t for t in every if t[0] == "b" or t[1] == "screen"}
     assert both.passes_for(1) == both.screen_passes == [(None, "ldl"), (None, "mumps")]
-    assert replace(both, screen_repeat_min_joints=5).passes_for(4) == [(None, "ldl")]
-    assert "fewer than 5 joints the first pass only" in replace(both, screen_repeat_min_joints=5).describe()
+    assert (once.passes_for(4), once.passes_for(5)) == ([(None, "ldl")], both.screen_passes)
+    assert "fewer than 5 joints the first pass only" in once.describe()
     assert "first pass only" not in both.describe()
-    assert "first pass only" not in replace(both, screen_linear_solver=("ldl",), screen_repeat_min_joints=5).describe()
+    assert "first pass only" not in replace(once, screen_linear_solver=("ldl",)).describe()
 
 
 def test_an_arm_of_fewer_than_five_joints_explores_from_wider_starts():

@@ -26,6 +26,11 @@ SMALL_ARM = 5
 direction; its spin is free) on a general design: its designs are structural, often far from a generic start."""
 
 
+def small_arm(moving_joints: int) -> bool:
+    """Whether an arm of ``moving_joints`` moving joints is small: fewer than `SMALL_ARM`."""
+    return moving_joints < SMALL_ARM
+
+
 @dataclass(frozen=True)
 class Search:
     """A strategy and its budget. Counts are per problem; iteration caps per solve.
@@ -50,11 +55,10 @@ class Search:
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
     solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None: the
     profile's; `SolverProfile.linear_solver`); ``screen_linear_solver``: the screen's, each candidate screened once
-    by each of them (and each barrier of ``screen_mu_init``: `screen_passes`); ``screen_repeat_min_joints``: the
-    screen's passes after the first only for a problem whose arm has at least this many moving joints (a smaller
-    arm's passes end in one basin: screened once, `passes_for`); 0: every problem every pass.
-    ``small_arm_perturbation``: the ``perturbation`` of the exploration's seeded starts of an arm with fewer than
-    `SMALL_ARM` moving joints (None: ``perturbation``; `perturbation_for`).
+    by each of them (and each barrier of ``screen_mu_init``: `screen_passes`). Two settings for a small arm (fewer
+    than `SMALL_ARM` moving joints, `small_arm`): ``small_arm_screens_once``, its candidates screened by the first
+    of those passes only (a small arm's passes end in one basin; `passes_for`); ``small_arm_perturbation``, the
+    ``perturbation`` of its exploration's seeded starts (None: ``perturbation``; `perturbation_for`).
     ``refine_mu_init``: the barrier parameters the refine's warm solves start from (IPOPT's ``mu_init``; None: the
     warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate refined once per value (stages
     ``refine``, ``refine2``, ...; the answer is the best of all): from a small one a refine stays in the basin its
@@ -94,7 +98,7 @@ class Search:
     explore_linear_solver: str | None = None
     screen_linear_solver: tuple[str | None, ...] = (None,)
     screen_mu_init: tuple[float | None, ...] = (None,)
-    screen_repeat_min_joints: int = 0
+    small_arm_screens_once: bool = False
     small_arm_perturbation: float | None = None
     refine_mu_init: tuple[float | None, ...] = (None,)
     reflect: int = 0
@@ -126,15 +130,15 @@ class Search:
     def perturbation_for(self, moving_joints: int) -> float:
         """The seeded starts' perturbation for an arm of ``moving_joints`` moving joints: ``small_arm_perturbation``
         below `SMALL_ARM` joints, when set, else ``perturbation``."""
-        if self.small_arm_perturbation is not None and moving_joints < SMALL_ARM:
+        if self.small_arm_perturbation is not None and small_arm(moving_joints):
             return self.small_arm_perturbation
         return self.perturbation
 
     def passes_for(self, moving_joints: int) -> list[tuple[float | None, str | None]]:
         """The screen's passes for an arm of ``moving_joints`` moving joints: every one of `screen_passes`, or only
-        the first when the arm has fewer than ``screen_repeat_min_joints``."""
+        the first for a small arm (`small_arm`) when ``small_arm_screens_once``."""
         passes = self.screen_passes
-        return passes if moving_joints >= self.screen_repeat_min_joints else passes[:1]
+        return passes[:1] if self.small_arm_screens_once and small_arm(moving_joints) else passes
 
     def describe(self) -> str:
         """The search in words."""
@@ -180,9 +184,9 @@ class Search:
 
     def _repeated(self) -> str:
         """Which arms the screen's passes after the first are for, in words (`passes_for`)."""
-        if len(self.screen_passes) < 2 or self.screen_repeat_min_joints <= 0:
+        if len(self.screen_passes) < 2 or not self.small_arm_screens_once:
             return ""
-        return f"; an arm of fewer than {self.screen_repeat_min_joints} joints the first pass only"
+        return f"; an arm of fewer than {SMALL_ARM} joints the first pass only"
 
     def _kkt(self, linear_solvers: tuple[str | None, ...]) -> str:
         """A stage's linear solvers in words (None: the profile's): one, only where it is not the profile's; several,
@@ -254,7 +258,7 @@ PRESETS: dict[str, Search] = {
     # side), references within 1.10x 6 -> 7 and 7 -> 7, structure bests lower / higher by > 1 % 12 / 6 and 13 / 6,
     # at 1.021x and 1.028x the sweep's solver time (docs/decisions.md, 2026-11-29)
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
-                    explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), screen_repeat_min_joints=5,
+                    explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), small_arm_screens_once=True,
                     small_arm_perturbation=0.6,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost

@@ -18,8 +18,8 @@ design optimal for the full path. Stages, each across every problem:
    on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter``
    and ranked again there: the coarse ranking alone often puts a design that lifts badly ahead of one that lifts
    well. Once per barrier of ``screen_mu_init`` and linear solver of ``screen_linear_solver`` (stages ``screen``,
-   ``screen2``, ...: `Search.screen_passes`; an arm with fewer than ``screen_repeat_min_joints`` joints the first
-   pass only), each candidate ranked by its better pass.
+   ``screen2``, ...: `Search.screen_passes`; a small arm the first pass only, when
+   ``small_arm_screens_once``), each candidate ranked by its better pass.
 3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
    once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
