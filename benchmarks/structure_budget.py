@@ -10,7 +10,11 @@ large-budget costs), the geometric mean of the ratios and the CPU:
         --variant quick: --variant rebranch4:rebranch=4 --variant starts80:starts=80 --json budget.json
     .venv/bin/python benchmarks/structure_budget.py --table budget.json    # [STRUCTURES]: only those
 
-A structure of 4-6 joints takes 4-20 s of CPU per run.
+``--save DIR`` also writes each run's best solution, ``DIR/<structure>_<seed>_<variant>.json`` (a solution file:
+``python -m designopt.verify`` re-checks it). A structure of 4-6 joints takes 4-20 s of CPU per run. Alone, a
+structure gets the preset's ``starts`` and ``screen``; in a sweep a smaller one gets more (`small_problem_starts`),
+so to search it as a sweep does, set them (a 5-joint structure in the K = I sweep: ``starts=56,screen=17,
+screen_waypoints=25,small_problem_starts=1``; 4 joints 84, 25, 32; 3 joints 139, 42, 40).
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ import pandas as pd
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
 from designopt.experiments.sweep import sweep_jobs
+from designopt.solution import write_solution
 from designopt.solve.strategies import run_search
 from designopt.solve.tasks import fan_out
 
@@ -41,7 +46,8 @@ def variant(text: str) -> tuple[str, dict]:
                   (item.split("=", 1) for item in filter(None, fields.split(",")))}
 
 
-def run(config: Path, structures: list[str], seeds: list[int], variants: list[str], out: Path) -> None:
+def run(config: Path, structures: list[str], seeds: list[int], variants: list[str], out: Path,
+        save: Path | None = None) -> None:
     cfg = load_config(config)
     rows = json.loads(out.read_text()) if out.exists() else []
     have = {(r["structure"], r["seed"], r["variant"]) for r in rows}
@@ -61,6 +67,9 @@ def run(config: Path, structures: list[str], seeds: list[int], variants: list[st
 
                 [searched] = run_search(sweep_jobs(cfg, [structure]), search, execute)
                 best = searched.best[1]
+                if save is not None and best is not None:
+                    save.mkdir(parents=True, exist_ok=True)
+                    write_solution(best, save / f"{structure}_{seed}_{name}.json")
                 rows.append({"structure": structure, "seed": seed, "variant": name, "solve_s": cpu,
                              "cost": float(best.metrics.design_cost) if best is not None else None})
                 out.write_text(json.dumps(rows))
@@ -86,13 +95,14 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, nargs="+", default=[0])
     parser.add_argument("--variant", action="append", default=[], metavar="NAME:FIELD=VALUE,...")
     parser.add_argument("--json", type=Path)
+    parser.add_argument("--save", type=Path, help="write each run's best solution file into this directory")
     parser.add_argument("--table", type=Path, nargs="+", help="tabulate runs written with --json")
     parser.add_argument("--references", type=Path, default=Path("benchmarks/reference/sweep_structures_k_i.csv"))
     args = parser.parse_args()
     if args.table:
         table(args.table, args.references, args.structures)
     else:
-        run(args.config, args.structures, args.seeds, args.variant or ["quick:"], args.json)
+        run(args.config, args.structures, args.seeds, args.variant or ["quick:"], args.json, args.save)
 
 
 if __name__ == "__main__":
