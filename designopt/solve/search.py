@@ -129,7 +129,7 @@ class Search:
 
     def perturbation_for(self, moving_joints: int) -> float:
         """The seeded starts' perturbation for an arm of ``moving_joints`` moving joints: ``small_arm_perturbation``
-        below `SMALL_ARM` joints, when set, else ``perturbation``."""
+        for a small arm (`small_arm`), when set, else ``perturbation``."""
         if self.small_arm_perturbation is not None and small_arm(moving_joints):
             return self.small_arm_perturbation
         return self.perturbation
