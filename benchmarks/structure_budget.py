@@ -50,6 +50,8 @@ def run(config: Path, structures: list[str], seeds: list[int], variants: list[st
         save: Path | None = None) -> None:
     cfg = load_config(config)
     rows = json.loads(out.read_text()) if out.exists() else []
+    if save is not None:
+        save.mkdir(parents=True, exist_ok=True)
     have = {(r["structure"], r["seed"], r["variant"]) for r in rows}
     for seed in seeds:
         for structure in structures:
@@ -68,7 +70,6 @@ def run(config: Path, structures: list[str], seeds: list[int], variants: list[st
                 [searched] = run_search(sweep_jobs(cfg, [structure]), search, execute)
                 best = searched.best[1]
                 if save is not None and best is not None:
-                    save.mkdir(parents=True, exist_ok=True)
                     write_solution(best, save / f"{structure}_{seed}_{name}.json")
                 rows.append({"structure": structure, "seed": seed, "variant": name, "solve_s": cpu,
                              "cost": float(best.metrics.design_cost) if best is not None else None})

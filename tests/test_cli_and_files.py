@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 import json
 import re
 from dataclasses import replace
@@ -200,8 +199,8 @@ def test_every_best_design_known_checks_out():
     modular = json.loads(kept[[p.name for p in kept].index("modular_best_known.json")].read_text())
     assert all((row["d"], row["a"], row["alpha"]) in modules for row in modular["dh"])
     # a sweep reference kept with its design (structures_k_i_<STRUCTURE>_best_known.json) is that design's cost
-    costs = {row["structure"]: float(row["reference_cost"]) for row in
-             csv.DictReader((root / "benchmarks" / "reference" / "sweep_structures_k_i.csv").open())}
+    costs = pd.read_csv(root / "benchmarks" / "reference" / "sweep_structures_k_i.csv").set_index("structure")
+    costs = costs.reference_cost
     backed = [p for p in kept if p.name.removeprefix("structures_k_i_").removesuffix("_best_known.json").isupper()]
     assert backed
     for path in backed:
