@@ -198,14 +198,17 @@ def test_every_best_design_known_checks_out():
     modules = set(catalogue_from_config(load_config(root / "configs" / "modular.yaml")).modules)
     modular = json.loads(kept[[p.name for p in kept].index("modular_best_known.json")].read_text())
     assert all((row["d"], row["a"], row["alpha"]) in modules for row in modular["dh"])
-    # a sweep reference kept with its design (structures_k_i_<STRUCTURE>_best_known.json) is that design's cost
-    costs = pd.read_csv(root / "benchmarks" / "reference" / "sweep_structures_k_i.csv").set_index("structure")
-    costs = costs.reference_cost
-    backed = [p for p in kept if p.name.removeprefix("structures_k_i_").removesuffix("_best_known.json").isupper()]
-    assert backed
-    for path in backed:
-        data = json.loads(path.read_text())
-        assert costs[data["structure"]] == pytest.approx(data["metrics"]["design_cost"], rel=1e-12), path
+    # a sweep reference kept with its design (structures_<model>_<STRUCTURE>_best_known.json) is that design's cost
+    for model in ("k_i", "physical"):
+        costs = pd.read_csv(root / "benchmarks" / "reference" / f"sweep_structures_{model}.csv").set_index("structure")
+        costs = costs.reference_cost
+        prefix = f"structures_{model}_"
+        backed = [p for p in kept if p.name.startswith(prefix)
+                  and p.name.removeprefix(prefix).removesuffix("_best_known.json").isupper()]
+        assert backed, model
+        for path in backed:
+            data = json.loads(path.read_text())
+            assert costs[data["structure"]] == pytest.approx(data["metrics"]["design_cost"], rel=1e-12, abs=0), path
 
 
 def test_a_run_draws_every_standard_figure_of_its_best_solution():
