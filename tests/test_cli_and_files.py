@@ -199,12 +199,10 @@ def test_every_best_design_known_checks_out():
     modular = json.loads(kept[[p.name for p in kept].index("modular_best_known.json")].read_text())
     assert all((row["d"], row["a"], row["alpha"]) in modules for row in modular["dh"])
     # a sweep reference kept with its design (structures_<model>_<STRUCTURE>_best_known.json) is that design's cost
+    reference = root / "benchmarks" / "reference"
     for model in ("k_i", "physical"):
-        costs = pd.read_csv(root / "benchmarks" / "reference" / f"sweep_structures_{model}.csv").set_index("structure")
-        costs = costs.reference_cost
-        prefix = f"structures_{model}_"
-        backed = [p for p in kept if p.name.startswith(prefix)
-                  and p.name.removeprefix(prefix).removesuffix("_best_known.json").isupper()]
+        costs = pd.read_csv(reference / f"sweep_structures_{model}.csv").set_index("structure").reference_cost
+        backed = sorted(reference.glob(f"structures_{model}_[PR]*_best_known.json"))  # verified above, as in `kept`
         assert backed, model
         for path in backed:
             data = json.loads(path.read_text())

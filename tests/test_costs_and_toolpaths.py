@@ -23,9 +23,9 @@ def test_one_joint_compliance_by_hand(L, k, alpha):
     expected = np.array([0, L * L, 0, 0, 0, L]) * alpha / k
     np.testing.assert_allclose(costs.deflection(J, np.array([1 / k]), F), expected)
     # abs=0: these costs go down to ~1e-12, where approx's default absolute tolerance (1e-12) would accept anything
-    exact = lambda value: pytest.approx(value, rel=1e-10, abs=0)  # noqa: E731
-    assert costs.deformation(J, np.array([1 / k]), F, "full") == exact((L**4 + L**2) * alpha**2 / k**2)
-    assert costs.deformation(J, np.array([1 / k]), F, "translational") == exact(L**4 * alpha**2 / k**2)
+    full, translational = (L**4 + L**2) * alpha**2 / k**2, L**4 * alpha**2 / k**2
+    assert costs.deformation(J, np.array([1 / k]), F, "full") == pytest.approx(full, rel=1e-10, abs=0)
+    assert costs.deformation(J, np.array([1 / k]), F, "translational") == pytest.approx(translational, rel=1e-10, abs=0)
 
 
 def test_compliance_is_symmetric_psd(rng):
