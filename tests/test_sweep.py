@@ -224,6 +224,11 @@ def test_a_second_pass_starts_only_from_the_structures_the_first_pass_lowered():
     # same-length starts: cold, from the neighbour's design, at most SAME_LENGTH_CAP iterations (the preset: 600)
     cap = neighbour_stage.SAME_LENGTH_CAP
     assert all(isinstance(t.start, Seeded) and not t.profile.warm and t.profile.max_iter == cap for t in first)
+    # each held from iteration 100 to 10x its own structure's best objective (1.5 x its cost: RRR 4.0, RPP 5.0),
+    # sooner than the grown and pruned starts (3x from 300)
+    assert {t.problem.chain.structure: t.bound for t in first} == {"RRR": Bound(pytest.approx(10 * 1.5 * 4.0), 100),
+                                                                   "RPP": Bound(pytest.approx(10 * 1.5 * 5.0), 100)}
+    assert "above_bound" in first[0].profile.observers
     landed = {"RRR": 1.0, "RPP": 6.0}
     second = plan.send([(t, solution(t.problem.chain.structure, landed[t.problem.chain.structure])) for t in first])
     assert [(t.problem.chain.structure, t.stage) for t in second] == [("RRP", "neighbour2")]

@@ -11,8 +11,9 @@ link's transform, so its solution without the link is an exact start too (`Prune
 solved on the full path (stage ``neighbour``) and join each problem's final solves; a second pass (``neighbour2``)
 gives starts from the structures whose best the first lowered, so that a design found there reaches the structures
 next to it (up to ``PASSES`` passes). A start that is still above ``BOUND_FACTOR`` times its structure's best
-objective after ``BOUND_AFTER`` iterations is stopped there (`designopt.solve.observers.AboveBound`). Problems
-without neighbours (every search of a single structure) get no task.
+objective after ``BOUND_AFTER`` iterations is stopped there (`designopt.solve.observers.AboveBound`), a cold
+same-length one already above ``COLD_BOUND_FACTOR`` times it after ``COLD_BOUND_AFTER``. Problems without
+neighbours (every search of a single structure) get no task.
 """
 
 from __future__ import annotations
@@ -49,6 +50,12 @@ PASSES = 2
 # 0.72x, references within 1.10x 5 + 3 either way, 2 and 0 structure bests higher by > 1 % (RRP 1.14x), none lower
 # (docs/decisions.md, "Speed").
 SAME_LENGTH_CAP = 200
+# A cold same-length start still above COLD_BOUND_FACTOR times its structure's best objective after COLD_BOUND_AFTER
+# iterations is stopped there. On the K = I sweeps of seeds 2156 and 2157, 130 and 115 of such starts reached the
+# cap of 200 above 10x; bounded (replays from the neighbour stage), the neighbour and later stages took 0.75x and
+# 0.74x their iterations and no structure best moved by > 1 %, where 3x or 10x from iteration 60 lost RRPR's
+# reference (its start took 194 iterations). Judged on fresh seeds 2158 and 2159 (docs/decisions.md, "Speed").
+COLD_BOUND_FACTOR, COLD_BOUND_AFTER = 10.0, 100
 
 
 def neighbours(structure: str, structures: list[str]) -> list[str]:
@@ -75,6 +82,12 @@ def still_first(solution) -> bool:
     shorter structure's, placed elsewhere (`starts.Pruned`)."""
     first = np.asarray(solution.raw.Q, float)[:, 0]
     return bool(np.ptp(first) < STILL)
+
+
+def held(own, factor: float, after: int) -> Bound | None:
+    """What a start is held to (`Bound`): ``factor`` times the NLP objective of its structure's best solution ``own``
+    from iteration ``after`` on; None (not held) when the structure has no best yet."""
+    return Bound(factor * own.raw.objective, after) if own is not None else None
 
 
 def plan(searched, search):
@@ -120,16 +133,18 @@ def _starts(searched, search, stage: str, lowered) -> list[Task]:
         for j, other in enumerate(same_length):
             if found := cheaper(job.case, other, own):
                 design = design_from(job.problem, found[0].problem, found[1].raw.q_d)
-                starts.append((cold, Seeded(search.seed, j, search.perturbation, search.init, design)))
+                starts.append((cold, Seeded(search.seed, j, search.perturbation, search.init, design),
+                               held(own, COLD_BOUND_FACTOR, COLD_BOUND_AFTER)))
         for k, (other, where) in enumerate(shorter(structure, same_case)):
             if found := cheaper(job.case, other, own):
-                starts.append((warm, Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)))
+                starts.append((warm, Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k),
+                               held(own, BOUND_FACTOR, BOUND_AFTER)))
         for k, other in enumerate(longer(structure, same_case)):
             if not (found := cheaper(job.case, other, own)) or not still_first(found[1]):
                 continue
             if (design := pruned_design(job.problem, found[0].problem, found[1])) is not None:
-                starts.append((warm, Pruned(found[1], design, search.seed, PRUNED_FROM + k)))
-        bound = Bound(BOUND_FACTOR * own.raw.objective, BOUND_AFTER) if own is not None else None
+                starts.append((warm, Pruned(found[1], design, search.seed, PRUNED_FROM + k),
+                               held(own, BOUND_FACTOR, BOUND_AFTER)))
         tasks += [Task(job.case, stage, job.problem, job.transcription, profile.observing("above_bound"), start,
-                       continuation, bound) for (profile, continuation), start in starts]
+                       continuation, bound) for (profile, continuation), start, bound in starts]
     return tasks
