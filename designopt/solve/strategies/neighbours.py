@@ -51,10 +51,11 @@ PASSES = 2
 # (docs/decisions.md, "Speed").
 SAME_LENGTH_CAP = 200
 # A cold same-length start still above COLD_BOUND_FACTOR times its structure's best objective after COLD_BOUND_AFTER
-# iterations is stopped there. On the K = I sweeps of seeds 2156 and 2157, 130 and 115 of such starts reached the
-# cap of 200 above 10x; bounded (replays from the neighbour stage), the neighbour and later stages took 0.75x and
-# 0.74x their iterations and no structure best moved by > 1 %, where 3x or 10x from iteration 60 lost RRPR's
-# reference (its start took 194 iterations). Judged on fresh seeds 2158 and 2159 (docs/decisions.md, "Speed").
+# iterations is stopped there. On the K = I sweeps of seeds 2156 and 2157 (tuning), 130 and 115 of such starts reached
+# the cap of 200 above 10x; 3x or 10x from iteration 60 lost RRPR's reference (its start took 194 iterations). Judged
+# on fresh seeds 2158 and 2159 (replays from the neighbour stage on): the neighbour and later stages 0.749x and 0.757x
+# their solver time (about 0.97x the sweep's), references within 1.10x 6 -> 6 and 8 -> 8, one structure best higher
+# by > 1 % (RPRRPP 1.020x), none lower (docs/decisions.md, "Speed").
 COLD_BOUND_FACTOR, COLD_BOUND_AFTER = 10.0, 100
 
 
