@@ -128,24 +128,23 @@ def _starts(searched, search, stage: str, lowered) -> list[Task]:
         job, own, structure = s.job, s.best[1], s.job.problem.chain.structure
         same_case = [st for case, st in best if case == job.case]
         same_length, starts = neighbours(structure, same_case), []
-        # same-length starts are solved cold (joints by IK), capped; grown and pruned ones already track the path: warm
-        cold = solve_setup(job, search, search.profile.capped(SAME_LENGTH_CAP))
-        warm = solve_setup(job, search, search.profile.warmed())
+        # same-length starts are solved cold (joints by IK), capped and held sooner; grown and pruned ones already track
+        # the path: warm. Each kind's (profile, continuation, bound)
+        cold = (*solve_setup(job, search, search.profile.capped(SAME_LENGTH_CAP)),
+                held(own, COLD_BOUND_FACTOR, COLD_BOUND_AFTER))
+        warm = (*solve_setup(job, search, search.profile.warmed()), held(own, BOUND_FACTOR, BOUND_AFTER))
         for j, other in enumerate(same_length):
             if found := cheaper(job.case, other, own):
                 design = design_from(job.problem, found[0].problem, found[1].raw.q_d)
-                starts.append((cold, Seeded(search.seed, j, search.perturbation, search.init, design),
-                               held(own, COLD_BOUND_FACTOR, COLD_BOUND_AFTER)))
+                starts.append((cold, Seeded(search.seed, j, search.perturbation, search.init, design)))
         for k, (other, where) in enumerate(shorter(structure, same_case)):
             if found := cheaper(job.case, other, own):
-                starts.append((warm, Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k),
-                               held(own, BOUND_FACTOR, BOUND_AFTER)))
+                starts.append((warm, Grown(found[1], found[0].problem, where, search.seed, len(same_length) + k)))
         for k, other in enumerate(longer(structure, same_case)):
             if not (found := cheaper(job.case, other, own)) or not still_first(found[1]):
                 continue
             if (design := pruned_design(job.problem, found[0].problem, found[1])) is not None:
-                starts.append((warm, Pruned(found[1], design, search.seed, PRUNED_FROM + k),
-                               held(own, BOUND_FACTOR, BOUND_AFTER)))
+                starts.append((warm, Pruned(found[1], design, search.seed, PRUNED_FROM + k)))
         tasks += [Task(job.case, stage, job.problem, job.transcription, profile.observing("above_bound"), start,
-                       continuation, bound) for (profile, continuation), start, bound in starts]
+                       continuation, bound) for (profile, continuation, bound), start in starts]
     return tasks
