@@ -23,8 +23,8 @@ from designopt.kinematics.reflections import Reflection, at_bound, reflections, 
 from designopt.problem import problem_from_config
 from designopt.solve.local import solve_guess
 from designopt.solve.profile import SolverProfile
-from designopt.solve.search import Job, Search
-from designopt.solve.strategies import run_search
+from designopt.solve.search import PRESETS, Job, Search
+from designopt.solve.strategies import reflect, run_search
 from designopt.solve.tasks import run_task
 from designopt.transcriptions import Collocation
 from designopt.transcriptions.base import InitialGuess
@@ -113,12 +113,10 @@ def _held_problem():
     return problem_from_config(parse_config(cfg))
 
 
-@pytest.mark.parametrize("strategy", ["coarse_to_fine", "multistart"])
-def test_a_design_held_at_a_length_bound_is_reflected_back_to_its_optimum(strategy):
-    """From the best design known's own basin, the optimum of the held problem; from its link-4 d-reflection with d4
-    clipped to the bound, a worse optimum with d4 at the bound. The reflect step (`Search.reflect`), after either
-    strategy, reflects that solution's d4 and solves warm: it reaches the optimum (the same design cost and design),
-    and a second round from the new best has nothing at a bound to reflect, so the step ends there."""
+@pytest.fixture(scope="module")
+def held_problem():
+    """(problem, optimum, held): the held problem (`_held_problem`), its optimum from the best design known's own
+    basin, and the worse optimum from that optimum's link-4 d-reflection with d4 clipped to the bound."""
     problem = _held_problem()
     chain, t = problem.chain, problem.toolpath.t
     profile = SolverProfile(max_iter=500).warmed()
@@ -129,9 +127,19 @@ def test_a_design_held_at_a_length_bound_is_reflected_back_to_its_optimum(strate
     q_d[d4.length(chain)] = 0.0
     Q = d4.joints(chain, optimum.sample(t))
     held = solve_guess(problem, Collocation(), profile, InitialGuess(q_d=q_d, Q=projected(problem, q_d, Q)))
+    return problem, optimum, held
+
+
+@pytest.mark.parametrize("strategy", ["coarse_to_fine", "multistart"])
+def test_a_design_held_at_a_length_bound_is_reflected_back_to_its_optimum(strategy, held_problem):
+    """From the best design known's own basin, the optimum of the held problem; from its link-4 d-reflection with d4
+    clipped to the bound, a worse optimum with d4 at the bound. The reflect step (`Search.reflect`), after either
+    strategy, reflects that solution's d4 and solves warm: it reaches the optimum (the same design cost and design),
+    and a second round from the new best has nothing at a bound to reflect, so the step ends there."""
+    problem, optimum, held = held_problem
     assert optimum.metrics.tracks and held.metrics.tracks
     assert held.metrics.design_cost > 1.2 * optimum.metrics.design_cost
-    assert [r.name for r in at_bound(chain, held.raw.q_d, 0.01)] == ["link4.d"]
+    assert [r.name for r in at_bound(problem.chain, held.raw.q_d, 0.01)] == ["link4.d"]
 
     def execute(tasks):  # the explore and refine stages end where the held solve did; the reflect stage solves
         return [(task, run_task(task) if task.stage.startswith("reflect") else held) for task in tasks]
@@ -149,3 +157,41 @@ def test_a_design_held_at_a_length_bound_is_reflected_back_to_its_optimum(strate
     np.testing.assert_allclose(best.raw.q_d, optimum.raw.q_d, atol=1e-4)
     assert "reflected across its length bounds (up to 3 rounds)" in search.describe()
     assert "reflected" not in replace(search, reflect=0).describe()
+
+
+def _second_optimum_search(problem, optimum, held, within):
+    """The stages a multistart of 3 starts with ``reflect_within`` = ``within`` runs when its starts end at
+    ``optimum``, ``held`` and ``held`` again (the same optimum twice), the reflect stage solving."""
+    answers = {0: optimum, 1: held, 2: held}
+
+    def execute(tasks):
+        return [(t, run_task(t) if t.stage.startswith("reflect") else answers[t.start.index]) for t in tasks]
+
+    stages = []
+    search = Search(strategy="multistart", starts=3, reflect=3, reflect_within=within,
+                    profile=SolverProfile(max_iter=500))
+    (searched,) = run_search([Job("", problem)], search, lambda tasks: stages.append(tasks) or execute(tasks))
+    return stages, searched
+
+
+def test_a_second_optimum_at_a_length_bound_is_reflected_when_near_the_best(held_problem):
+    """The best optimum has no length at a bound and the second (d4 held at 0, 1.2-2x its cost) has: the reflect
+    step that reflects the best alone solves nothing; with ``reflect_within`` above the second's ratio the first round
+    reflects it too (once, though two starts ended there: one optimum), numbered after the best's reflections, and
+    the answer is the optimum; with ``reflect_within`` below the ratio, nothing again."""
+    problem, optimum, held = held_problem
+    ratio = held.metrics.design_cost / optimum.metrics.design_cost
+    assert 1.2 < ratio < 2.0 and not at_bound(problem.chain, optimum.raw.q_d, 1e-4)
+    stages, searched = _second_optimum_search(problem, optimum, held, None)
+    assert [{t.stage for t in tasks} for tasks in stages] == [{"start"}]
+    assert searched.best[1] is optimum
+    stages, _ = _second_optimum_search(problem, optimum, held, 0.99 * ratio)
+    assert [{t.stage for t in tasks} for tasks in stages] == [{"start"}]
+    stages, searched = _second_optimum_search(problem, optimum, held, 2.0)
+    assert [{t.stage for t in tasks} for tasks in stages] == [{"start"}, {"reflect"}]
+    (task,) = stages[1]
+    assert task.start.solution is held and task.start.reflection.name == "link4.d"
+    assert task.start.index == reflect.FIRST_START + reflect.LEADER_STRIDE
+    (solved,) = [sol for t, sol in searched.final if t is task]
+    np.testing.assert_allclose(solved.metrics.design_cost, optimum.metrics.design_cost, rtol=1e-5)
+    assert "every distinct optimum within 2x of the best" in replace(PRESETS["default"], reflect_within=2.0).describe()

@@ -98,7 +98,7 @@ def test_run_resumes(tmp_path):
     keys = set(read_summary(run / "summary.csv")[KEY].itertuples(index=False, name=None))
     refined = {k for k in keys if k[1] == "refine"}
     assert 1 <= len(refined) <= 4  # the best four distinct coarse optima, refined on the full path
-    reflected = {k for k in keys if k[1].startswith("reflect")}  # the best reflected across its length bounds, if any
+    reflected = {k for k in keys if k[1].startswith("reflect")}  # optima reflected across their length bounds, if any
     after = check_resumed(run, before, {("", "explore", "to", "RRRRRR", s) for s in range(5)} | refined | reflected,
                           result)
     assert after["best"].sum() == 1 and (run / "best.json").is_file()

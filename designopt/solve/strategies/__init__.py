@@ -4,7 +4,7 @@ A strategy module has ``plan(jobs, search)``, a generator that yields one stage'
 their (task, solution) pairs, and at the end returns one `Searched` per job. Adding a strategy is a module here
 and a line in `STRATEGIES`. Three steps serve every strategy: `continuation` (finishing a solve stalled on a
 degenerate design), then, after the strategy, `neighbours` (starts from a neighbouring structure's better design)
-and `reflect` (each best reflected across the length bounds it lies at).
+and `reflect` (each best, or each optimum near it, reflected across the length bounds it lies at).
 """
 
 from __future__ import annotations

@@ -7,14 +7,16 @@ the same arm with the length free to grow on the other side. After the strategy 
 ``search.reflect`` rounds (stages ``reflect``, ``reflect2``, ...): each problem's best full-path solution, reflected
 across each length within ``WITHIN`` of its bound of 0 and pushed ``search.distinct`` across (`starts.Reflected`),
 is solved warm on the full path from barrier ``MU_INIT``; the next round reflects each new best, while a round
-lowers some problem's best design cost by more than ``GAIN`` (a fraction). The step only adds solves: an answer
+lowers some problem's best design cost by more than ``GAIN`` (a fraction). With ``search.reflect_within`` set, the
+first round reflects every distinct full-path optimum within that factor of the best (`leading`): a runner-up held at
+a bound is often a better arm than the best once reflected. The step only adds solves: an answer
 can only fall. Problems with nothing at a bound get no task.
 """
 
 from __future__ import annotations
 
 from designopt.kinematics.reflections import at_bound
-from designopt.solve.optima import best_solution
+from designopt.solve.optima import best_solution, distinct_best
 from designopt.solve.search import Searched, by_job
 from designopt.solve.starts import Reflected
 from designopt.solve.strategies.steps import numbered_stage, solve_setup
@@ -31,18 +33,22 @@ WITHIN = 1e-4
 MU_INIT = 1e-6
 GAIN = 1e-3
 FIRST_START = 900  # the first start index of a reflect stage's starts, after any exploration's
+LEADER_STRIDE = 100  # the start indices of the j-th optimum a round reflects: from FIRST_START + j * LEADER_STRIDE
 
 
 def plan(searched: list[Searched], search):
-    """Up to ``search.reflect`` rounds over every problem's best full-path solution (a generator, as a strategy's
-    plan: yields a round's tasks, receives their solutions); returns ``searched`` with the rounds' solves added to
-    each problem's final solves."""
+    """Up to ``search.reflect`` rounds over every problem's best full-path solution (the first round over its
+    `leading` optima; a generator, as a strategy's plan: yields a round's tasks, receives their solutions); returns
+    ``searched`` with the rounds' solves added to each problem's final solves."""
     jobs = [s.job for s in searched]
     final = [list(s.final) for s in searched]
     looked_at = [None] * len(jobs)  # per job, the best solution the last round reflected
     for i in range(search.reflect):
         bests = [best_solution([sol for _, sol in done]) for done in final]
-        tasks = reflected_tasks([(job, best) for job, best, last in zip(jobs, bests, looked_at, strict=True)
+        leaders = [leading([sol for _, sol in done], best, search) if i == 0 else [best]
+                   for done, best in zip(final, bests, strict=True)]
+        tasks = reflected_tasks([(job, optima) for job, optima, best, last in zip(jobs, leaders, bests, looked_at,
+                                                                                  strict=True)
                                  if best is not None and best is not last], numbered_stage(STAGE, i), search)
         if not tasks:
             break
@@ -56,20 +62,35 @@ def plan(searched: list[Searched], search):
     return [Searched(s.job, s.explore, f) for s, f in zip(searched, final, strict=True)]
 
 
-def reflected_tasks(bests, stage_name: str, search) -> list[Task]:
-    """For every (job, best full-path solution), a task per length of that solution within ``WITHIN`` of its bound
-    of 0 whose reflection keeps the motion within the joints' bounds (`kinematics.reflections.at_bound`), starting
-    from the solution reflected and pushed ``search.distinct`` across (`Reflected`), solved warm on the full path
-    from barrier ``MU_INIT``. Start indices from ``FIRST_START`` on."""
+def leading(solutions, best, search) -> list:
+    """The optima the first round reflects: ``best`` alone, or with ``search.reflect_within`` set, every distinct
+    optimum among ``solutions`` (`optima.distinct_best`, ``search.distinct`` apart) whose design cost is within that
+    factor of ``best``'s, cheapest first (``best`` among them). Empty when nothing tracks."""
+    if best is None:
+        return []
+    if search.reflect_within is None:
+        return [best]
+    top = search.reflect_within * best.metrics.design_cost
+    optima = [solutions[k] for k in distinct_best(solutions, len(solutions), search.distinct)]
+    return [s for s in optima if s.metrics.design_cost <= top]
+
+
+def reflected_tasks(leaders, stage_name: str, search) -> list[Task]:
+    """For every (job, its optima to reflect, cheapest first), a task per length of each optimum within ``WITHIN``
+    of its bound of 0 whose reflection keeps the motion within the joints' bounds (`kinematics.reflections.at_bound`),
+    starting from the solution reflected and pushed ``search.distinct`` across (`Reflected`), solved warm on the
+    full path from barrier ``MU_INIT``. The j-th optimum's start indices from ``FIRST_START + j * LEADER_STRIDE``
+    on (the best's from ``FIRST_START``)."""
     warm = search.profile.warmed().with_options(**{"ipopt.mu_init": MU_INIT})
     tasks = []
-    for job, best in bests:
+    for job, optima in leaders:
         chain = job.problem.chain
         profile, continuation = solve_setup(job, search, warm)
-        Q = best.sample(job.problem.toolpath.t)
-        for k, reflection in enumerate(at_bound(chain, best.raw.q_d, WITHIN)):
-            if reflection.joints(chain, Q) is None:
-                continue
-            start = Reflected(best, reflection, search.distinct, search.seed, FIRST_START + k)
-            tasks.append(Task(job.case, stage_name, job.problem, job.transcription, profile, start, continuation))
+        for j, best in enumerate(optima):
+            Q = best.sample(job.problem.toolpath.t)
+            for k, reflection in enumerate(at_bound(chain, best.raw.q_d, WITHIN)):
+                if reflection.joints(chain, Q) is None:
+                    continue
+                start = Reflected(best, reflection, search.distinct, search.seed, FIRST_START + j * LEADER_STRIDE + k)
+                tasks.append(Task(job.case, stage_name, job.problem, job.transcription, profile, start, continuation))
     return tasks
