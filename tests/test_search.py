@@ -416,6 +416,27 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
         [False] * len(seeded) + [True] * len(rebranched))
 
 
+def test_the_second_rounds_leaders_get_their_starts_by_rank():
+    """``rebranch_shares``: the second round's leader of rank k starts the k-th entry's number of times, a leader past
+    the entries (a new form's) ``rebranch_starts``; the start numbers run on from ``most_starts`` without a gap, all of
+    the second round. Without shares every leader starts ``rebranch_starts`` times."""
+    problem = problem_from_config(parse_config({}))
+    a, b, c = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0), (1, 0, 1, 0, 1)
+    sols = [_optimum(problem, cost, form, shift) for cost, form, shift in
+            ((1.0, a, 0.0), (2.0, a, 0.1), (3.0, b, 0.0), (4.0, b, 0.2), (5.0, a, 0.3), (6.0, c, 0.0))]
+    task = Task("", "explore", problem, Collocation(), SolverProfile(), Seeded(0, 0))
+    shared = Search(starts=4, rebranch=2, rebranch_new_forms=1, rebranch_shares=(3, 1), seed=5)
+    tasks = rebranched_tasks([[(task, s) for s in sols]], shared)
+    assert shared.rebranch_starts == 2 and [shared.leader_starts(k) for k in range(3)] == [3, 1, 2]
+    assert [t.start.solution for t in tasks] == [sols[0]] * 3 + [sols[1]] + [sols[2]] * 2
+    assert [t.start.index for t in tasks] == list(range(4, 10))
+    assert all(shared.second_round(t.seed) for t in tasks)
+    assert "restarted 3, 1 times by rank" in shared.describe()
+    even = rebranched_tasks([[(task, s) for s in sols]], replace(shared, rebranch_shares=None))
+    assert [t.start.solution for t in even] == [sols[0]] * 2 + [sols[1]] * 2 + [sols[2]] * 2
+    assert "restarted 2 times each" in replace(shared, rebranch_shares=None).describe()
+
+
 def test_a_smaller_problem_of_a_batch_gets_more_exploration_starts():
     """`Search.small_problem_starts`: in a batch, a problem with fewer unknowns n (moving joints x the exploration's
     waypoints + design joints) gets starts x (n_max / n)^2, at most that factor x starts; 1 (the default), one

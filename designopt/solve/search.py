@@ -42,7 +42,8 @@ class Search:
     the path's waypoints (each capped at ``explore_max_iter``), then the ``rebranch`` best distinct of their optima
     (at most ``rebranch_per_form`` of one form, the pattern of the arm's joint axes, before other forms:
     `optima.distinct_best`; None: by cost alone), and the cheapest of each of up to ``rebranch_new_forms`` forms
-    not among them, each started again ``starts // rebranch`` times (at least once) on
+    not among them, each started again ``starts // rebranch`` times (at least once; ``rebranch_shares``: the
+    leader of rank k as many times as its k-th entry, where there is one: `leader_starts`) on
     a new joint branch (the optimum's design, first joints drawn over the whole circle:
     `designopt.solve.starts.Rebranched`; 0: none), explored alike; the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
@@ -88,6 +89,7 @@ class Search:
     rebranch: int = 8
     rebranch_per_form: int | None = None
     rebranch_new_forms: int = 0
+    rebranch_shares: tuple[int, ...] | None = None
     screen_waypoints: int = 40
     screen: int = 12
     screen_per_form: int | None = None
@@ -111,6 +113,13 @@ class Search:
     def rebranch_starts(self) -> int:
         """Starts on new joint branches per rebranched optimum: the second round as large as the first."""
         return max(1, self.starts // self.rebranch) if self.rebranch else 0
+
+    def leader_starts(self, rank: int) -> int:
+        """The second round's starts from its leader of ``rank`` (0: the cheapest): ``rebranch_shares[rank]`` where
+        set and long enough, else ``rebranch_starts`` (a new form's leader, after the ``rebranch`` leaders, too)."""
+        if self.rebranch_shares is not None and rank < len(self.rebranch_shares):
+            return self.rebranch_shares[rank]
+        return self.rebranch_starts
 
     @property
     def most_starts(self) -> int:
@@ -176,8 +185,10 @@ class Search:
                     else "")
         if self.rebranch_new_forms:
             per_form += f" and the best of up to {self.rebranch_new_forms} forms not among them"
-        again = (f", the best {self.rebranch} distinct{per_form} restarted {self.rebranch_starts} times each on a "
-                 f"new joint branch" if self.rebranch else "")
+        times = (f"{self.rebranch_starts} times each" if self.rebranch_shares is None else
+                 f"{', '.join(str(n) for n in self.rebranch_shares)} times by rank")
+        again = (f", the best {self.rebranch} distinct{per_form} restarted {times} on a new joint branch"
+                 if self.rebranch else "")
         kkt = self._kkt((self.explore_linear_solver,))
         barrier = _barriers(self.refine_mu_init)
         if self.small_problem_starts > 1:

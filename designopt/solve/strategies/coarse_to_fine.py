@@ -121,18 +121,19 @@ def rebranched_tasks(found, search) -> list[Task]:
     """For every job's exploration (its (task, solution) pairs), its ``search.rebranch`` best distinct coarse optima
     (at most ``search.rebranch_per_form`` of one form before other forms: `optima.distinct_best`), and the
     cheapest of each of up to ``search.rebranch_new_forms`` forms not among them, each started
-    ``search.rebranch_starts`` (``starts // rebranch``) times on a new joint branch, as the task that found it (the
-    same coarse problem, profile and continuation); start indices follow the exploration's (``search.most_starts``
-    onwards)."""
-    tasks, m = [], search.rebranch_starts
+    ``search.leader_starts(rank)`` (``starts // rebranch`` unless ``rebranch_shares``) times on a new joint branch,
+    as the task that found it (the same coarse problem, profile and continuation); start indices follow the
+    exploration's (``search.most_starts`` onwards), one after the other."""
+    tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
                                 search.rebranch_new_forms)
+        index = search.most_starts
         for k, i in enumerate(leaders):
             first, sol = done[i]
-            for j in range(m):
-                start = Rebranched(sol, search.seed, search.most_starts + k * m + j, search.init)
-                tasks.append(replace(first, start=start))
+            for _ in range(search.leader_starts(k)):
+                tasks.append(replace(first, start=Rebranched(sol, search.seed, index, search.init)))
+                index += 1
     return tasks
 
 
