@@ -50,23 +50,16 @@ def priced(base: pd.DataFrame, variant: pd.DataFrame) -> pd.DataFrame:
         return totals["solve_time_s"] / totals["iterations"].where(totals["iterations"] > 0)
 
     per = rate(base).rename("per")
-    refine = per.xs("refine", level="stage").rename("refine_per") if "refine" in set(base["stage"]) else None
+    refine = per.xs("refine", level="stage") if "refine" in set(base["stage"]) else pd.Series(dtype=float)
     overall = base["solve_time_s"].sum() / base["iterations"].sum()
     v = variant.join(per, on=["structure", "stage"])
-    if refine is not None:
-        v = v.join(refine, on="structure")
-        v["per"] = v["per"].fillna(v["refine_per"])
-    v["seconds"] = v["iterations"] * v["per"].fillna(overall)
-    b = base.assign(seconds=base["solve_time_s"])
-    table = pd.DataFrame({
-        "solves": b.groupby(b["stage"].map(stage_kind)).size(),
-        "iterations": b.groupby(b["stage"].map(stage_kind))["iterations"].sum(),
-        "seconds": b.groupby(b["stage"].map(stage_kind))["seconds"].sum(),
-        "variant solves": v.groupby(v["stage"].map(stage_kind)).size(),
-        "variant iterations": v.groupby(v["stage"].map(stage_kind))["iterations"].sum(),
-        "variant seconds (priced)": v.groupby(v["stage"].map(stage_kind))["seconds"].sum(),
-    }).fillna(0)
-    return table
+    v["seconds"] = v["iterations"] * v["per"].fillna(v["structure"].map(refine)).fillna(overall)
+    by_kind = [frame.groupby(frame["stage"].map(stage_kind)).agg(
+        solves=("iterations", "size"), iterations=("iterations", "sum"), seconds=("seconds", "sum"))
+        for frame in (base.assign(seconds=base["solve_time_s"]), v)]
+    variant_columns = {"solves": "variant solves", "iterations": "variant iterations",
+                       "seconds": "variant seconds (priced)"}
+    return pd.concat([by_kind[0], by_kind[1].rename(columns=variant_columns)], axis=1).fillna(0)
 
 
 def main() -> None:

@@ -307,8 +307,7 @@ PRESETS: dict[str, Search] = {
     # job 1587-1606, the other two 1484-1503), replays of the default's runs, seeds better / worse 5 / 0, 3 / 0, 1 / 0
     # at 1.006x, 1.036x, 1.017x the solve time (docs/benchmarks.md, "Runner-up optima reflected")
     "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
-                      refine_mu_init=(None, 1e-6), rebranch_new_forms=2, reflect=3,
-                      reflect_within=1.05),
+                      refine_mu_init=(None, 1e-6), rebranch_new_forms=2, reflect=3, reflect_within=1.05),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,

@@ -45,10 +45,9 @@ def plan(searched: list[Searched], search):
     looked_at = [None] * len(jobs)  # per job, the best solution the last round reflected
     for i in range(search.reflect):
         bests = [best_solution([sol for _, sol in done]) for done in final]
-        leaders = [leading([sol for _, sol in done], best, search) if i == 0 else [best]
-                   for done, best in zip(final, bests, strict=True)]
-        tasks = reflected_tasks([(job, optima) for job, optima, best, last in zip(jobs, leaders, bests, looked_at,
-                                                                                  strict=True)
+        within = search.reflect_within if i == 0 else None  # later rounds: the new best alone
+        tasks = reflected_tasks([(job, leading([sol for _, sol in done], best, within, search.distinct))
+                                 for job, done, best, last in zip(jobs, final, bests, looked_at, strict=True)
                                  if best is not None and best is not last], numbered_stage(STAGE, i), search)
         if not tasks:
             break
@@ -62,17 +61,14 @@ def plan(searched: list[Searched], search):
     return [Searched(s.job, s.explore, f) for s, f in zip(searched, final, strict=True)]
 
 
-def leading(solutions, best, search) -> list:
-    """The optima the first round reflects: ``best`` alone, or with ``search.reflect_within`` set, every distinct
-    optimum among ``solutions`` (`optima.distinct_best`, ``search.distinct`` apart) whose design cost is within that
-    factor of ``best``'s, cheapest first (``best`` among them). Empty when nothing tracks."""
-    if best is None:
-        return []
-    if search.reflect_within is None:
+def leading(solutions, best, within: float | None, distinct: float) -> list:
+    """The optima a round reflects: ``best`` (the best of ``solutions``) alone when ``within`` is None, else every
+    distinct optimum among ``solutions`` (`optima.distinct_best`, ``distinct`` apart) whose design cost is within
+    that factor of ``best``'s, cheapest first (``best`` among them)."""
+    if within is None:
         return [best]
-    top = search.reflect_within * best.metrics.design_cost
-    optima = [solutions[k] for k in distinct_best(solutions, len(solutions), search.distinct)]
-    return [s for s in optima if s.metrics.design_cost <= top]
+    optima = [solutions[k] for k in distinct_best(solutions, len(solutions), distinct)]
+    return [s for s in optima if s.metrics.design_cost <= within * best.metrics.design_cost]
 
 
 def reflected_tasks(leaders, stage_name: str, search) -> list[Task]:
