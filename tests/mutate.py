@@ -196,7 +196,7 @@ MUTATIONS = [
     Mutation("the second round left out of the screen's pool", "designopt/solve/strategies/coarse_to_fine.py",
              "explored = [first + more for first, more in", "explored = [first for first, more in"),
     Mutation("rebranched starts numbered over the seeded ones", "designopt/solve/strategies/coarse_to_fine.py",
-             "search.seed, search.most_starts + k * m + j,", "search.seed, k * m + j,"),
+             "        index = search.most_starts\n", "        index = 0\n"),
     # degenerate designs (issue 12, cause 3)
     Mutation("a moving target's row held once", "designopt/transcriptions/degeneracy.py",
              "if i in POSITION_ROWS and tracked.any() and np.ptp(tp.points_W[tracked, i]) > 1e-12:",
