@@ -437,6 +437,32 @@ def test_the_second_rounds_leaders_get_their_starts_by_rank():
     assert "restarted 2 times each" in replace(shared, rebranch_shares=None).describe()
 
 
+def test_a_later_round_on_new_joint_branches_starts_from_the_best_of_every_round_before_it():
+    """``rebranch_rounds``: the rounds on new joint branches share the first round's count (``starts // (rebranch x
+    rounds)`` per leader), each from the best distinct optima of every round before it, numbered in blocks from
+    ``most_starts`` (`Search.round_start`), every one of them told apart from the first round. Driven through the
+    plan: the explored solves in, each round's tasks out."""
+    problem = problem_from_config(parse_config({}))
+    a = (0, 0, 1, 0, 1)
+    search = Search(starts=4, rebranch=2, rebranch_rounds=2, seed=5)
+    assert search.rebranch_starts == 1 and [search.round_start(r) for r in range(3)] == [4, 6, 8]
+    assert replace(search, rebranch_rounds=1).rebranch_starts == 2
+    plan = coarse_to_fine.plan([Job("", problem)], search)
+    explore = next(plan)
+    first = [_optimum(problem, cost, a, shift) for cost, shift in ((3.0, 0.0), (1.0, 0.1), (2.0, 0.2), (4.0, 0.3))]
+    round1 = plan.send(list(zip(explore, first, strict=True)))
+    assert [t.start.solution for t in round1] == [first[1], first[2]]
+    assert [t.start.index for t in round1] == [4, 5]
+    found = [_optimum(problem, 0.5, a, 0.4), _optimum(problem, 5.0, a, 0.5)]  # the first leader's start did better
+    round2 = plan.send(list(zip(round1, found, strict=True)))
+    assert [t.start.solution for t in round2] == [found[0], first[1]]
+    assert [t.start.index for t in round2] == [6, 7]
+    assert all(search.second_round(t.seed) for t in round1 + round2)
+    assert not any(search.second_round(t.seed) for t in explore)
+    assert "in 2 rounds, each from the best of every round before it" in search.describe()
+    assert "rounds" not in replace(search, rebranch_rounds=1).describe()
+
+
 def test_a_smaller_problem_of_a_batch_gets_more_exploration_starts():
     """`Search.small_problem_starts`: in a batch, a problem with fewer unknowns n (moving joints x the exploration's
     waypoints + design joints) gets starts x (n_max / n)^2, at most that factor x starts; 1 (the default), one

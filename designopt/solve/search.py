@@ -45,7 +45,8 @@ class Search:
     not among them, each started again ``starts // rebranch`` times (at least once; ``rebranch_shares``: the
     leader of rank k as many times as its k-th entry, where there is one: `leader_starts`) on
     a new joint branch (the optimum's design, first joints drawn over the whole circle:
-    `designopt.solve.starts.Rebranched`; 0: none), explored alike; the
+    `designopt.solve.starts.Rebranched`; 0: none), explored alike (``rebranch_rounds`` > 1: that many such rounds,
+    each from the best of every round before it, sharing ``starts // rebranch`` per leader); the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
     cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
     more waypoints), and the
@@ -90,6 +91,7 @@ class Search:
     rebranch_per_form: int | None = None
     rebranch_new_forms: int = 0
     rebranch_shares: tuple[int, ...] | None = None
+    rebranch_rounds: int = 1
     screen_waypoints: int = 40
     screen: int = 12
     screen_per_form: int | None = None
@@ -111,8 +113,9 @@ class Search:
 
     @property
     def rebranch_starts(self) -> int:
-        """Starts on new joint branches per rebranched optimum: the second round as large as the first."""
-        return max(1, self.starts // self.rebranch) if self.rebranch else 0
+        """Starts on new joint branches per rebranched optimum: the rounds on new joint branches together as large as
+        the first (``rebranch_rounds`` of them, each from the best distinct optima of every round before it)."""
+        return max(1, self.starts // (self.rebranch * self.rebranch_rounds)) if self.rebranch else 0
 
     def leader_starts(self, rank: int) -> int:
         """The second round's starts from its leader of ``rank`` (0: the cheapest): ``rebranch_shares[rank]`` where
@@ -126,6 +129,12 @@ class Search:
         """The most exploration starts one problem gets (`exploration_starts`): the second round's start indices
         follow them."""
         return math.ceil(self.starts * max(self.small_problem_starts, 1.0))
+
+    def round_start(self, r: int) -> int:
+        """The first start index of round ``r`` on new joint branches (0: the second round of the exploration):
+        ``most_starts``, then one block per round, as large as a round can be (every leader's starts)."""
+        leaders = self.rebranch + self.rebranch_new_forms
+        return self.most_starts + r * sum(self.leader_starts(k) for k in range(leaders))
 
     def second_round(self, number):
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,
@@ -187,6 +196,8 @@ class Search:
             per_form += f" and the best of up to {self.rebranch_new_forms} forms not among them"
         times = (f"{self.rebranch_starts} times each" if self.rebranch_shares is None else
                  f"{', '.join(str(n) for n in self.rebranch_shares)} times by rank")
+        if self.rebranch_rounds > 1:
+            times += f", in {self.rebranch_rounds} rounds, each from the best of every round before it,"
         again = (f", the best {self.rebranch} distinct{per_form} restarted {times} on a new joint branch"
                  if self.rebranch else "")
         kkt = self._kkt((self.explore_linear_solver,))

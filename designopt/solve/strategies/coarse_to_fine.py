@@ -13,6 +13,8 @@ design optimal for the full path. Stages, each across every problem:
    rebranch`` times with their design on a new joint branch
    (first joints over the whole circle, `Rebranched`), explored alike and pooled with the first round: a start lands in
    the best basin only when its design and its branch both fit, and good designs are where to look for branches.
+   With ``rebranch_rounds`` > 1 the rounds on new joint branches share those starts, each round from the best
+   distinct optima of every round before it.
 2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem of several more,
    on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter``
@@ -117,18 +119,18 @@ def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:
     return out
 
 
-def rebranched_tasks(found, search) -> list[Task]:
+def rebranched_tasks(found, search, first_index: int | None = None) -> list[Task]:
     """For every job's exploration (its (task, solution) pairs), its ``search.rebranch`` best distinct coarse optima
     (at most ``search.rebranch_per_form`` of one form before other forms: `optima.distinct_best`), and the
     cheapest of each of up to ``search.rebranch_new_forms`` forms not among them, each started
     ``search.leader_starts(rank)`` (``starts // rebranch`` unless ``rebranch_shares``) times on a new joint branch,
     as the task that found it (the same coarse problem, profile and continuation); start indices follow the
-    exploration's (``search.most_starts`` onwards), one after the other."""
+    exploration's (``search.most_starts`` onwards, or ``first_index`` for a later round), one after the other."""
     tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
                                 search.rebranch_new_forms)
-        index = search.most_starts
+        index = search.round_start(0) if first_index is None else first_index
         for k, i in enumerate(leaders):
             first, sol = done[i]
             for _ in range(search.leader_starts(k)):
@@ -145,8 +147,9 @@ def plan(jobs, search):
         explore += seeded_tasks(job, "explore", coarse, profile, search, starts)
     explored = by_job(jobs, (yield explore))
     if search.rebranch:
-        again = by_job(jobs, (yield rebranched_tasks(explored, search)))
-        explored = [first + more for first, more in zip(explored, again, strict=True)]
+        for r in range(search.rebranch_rounds):  # each round from the best distinct optima of every round before it
+            again = by_job(jobs, (yield rebranched_tasks(explored, search, search.round_start(r))))
+            explored = [first + more for first, more in zip(explored, again, strict=True)]
     candidates = explored
     screened = [k for k, job in enumerate(jobs) if 0 < search.screen_waypoints < job.problem.toolpath.n]
     if screened:
