@@ -118,8 +118,9 @@ class Search:
         return max(1, self.starts // (self.rebranch * self.rebranch_rounds)) if self.rebranch else 0
 
     def leader_starts(self, rank: int) -> int:
-        """The second round's starts from its leader of ``rank`` (0: the cheapest): ``rebranch_shares[rank]`` where
-        set and long enough, else ``rebranch_starts`` (a new form's leader, after the ``rebranch`` leaders, too)."""
+        """A round's starts on new joint branches from its leader of ``rank`` (0: the cheapest):
+        ``rebranch_shares[rank]`` where set and long enough, else ``rebranch_starts`` (a new form's leader, after the
+        ``rebranch`` leaders, too)."""
         if self.rebranch_shares is not None and rank < len(self.rebranch_shares):
             return self.rebranch_shares[rank]
         return self.rebranch_starts

@@ -119,18 +119,19 @@ def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:
     return out
 
 
-def rebranched_tasks(found, search, first_index: int | None = None) -> list[Task]:
+def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     """For every job's exploration (its (task, solution) pairs), its ``search.rebranch`` best distinct coarse optima
     (at most ``search.rebranch_per_form`` of one form before other forms: `optima.distinct_best`), and the
     cheapest of each of up to ``search.rebranch_new_forms`` forms not among them, each started
     ``search.leader_starts(rank)`` (``starts // rebranch`` unless ``rebranch_shares``) times on a new joint branch,
     as the task that found it (the same coarse problem, profile and continuation); start indices follow the
-    exploration's (``search.most_starts`` onwards, or ``first_index`` for a later round), one after the other."""
+    exploration's, one after the other from round ``round_``'s block (`Search.round_start`; round 0 from
+    ``search.most_starts``)."""
     tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
                                 search.rebranch_new_forms)
-        index = search.round_start(0) if first_index is None else first_index
+        index = search.round_start(round_)
         for k, i in enumerate(leaders):
             first, sol = done[i]
             for _ in range(search.leader_starts(k)):
@@ -148,7 +149,7 @@ def plan(jobs, search):
     explored = by_job(jobs, (yield explore))
     if search.rebranch:
         for r in range(search.rebranch_rounds):  # each round from the best distinct optima of every round before it
-            again = by_job(jobs, (yield rebranched_tasks(explored, search, search.round_start(r))))
+            again = by_job(jobs, (yield rebranched_tasks(explored, search, r)))
             explored = [first + more for first, more in zip(explored, again, strict=True)]
     candidates = explored
     screened = [k for k, job in enumerate(jobs) if 0 < search.screen_waypoints < job.problem.toolpath.n]
