@@ -13,10 +13,13 @@
  *          workspace the pattern was built in: IW's address (two ints) and LIW
  *   IW: nnzA nnzL nz accepted last | Ap[n+1] Ai[nnzA] (the permuted upper triangle, every diagonal present) |
  *       Lp[n+1] Li[nnzL] | etree[n] Lnz[n] | perm[n] (P, for ma27cd) | iwork[3n] (QDLDL's) | bwork[n] (QDLDL's) |
- *       map[nz] (triplet -> Ai slot) | scratch for building the pattern [2 nz + 2 n]
+ *       map[nz] (triplet -> Ai slot) | Rp[n+1] Ri[nnzL] (the rows of L's pattern, `QDLDL_rows`) |
+ *       scratch for building the pattern [2 nz + 2 n]
  *   A: the triplets' values[nz] (written by IPOPT) | Ax[nnzA] | Lx[nnzL] | D[n] | Dinv[n] | fwork[n] | x[n]
  * The pattern of IW is built at the first factorisation of an analysis and reused by the next ones, so a
- * factorisation is a scatter of the values and QDLDL's numeric pass. Whether IW holds this analysis's pattern is
+ * factorisation is a scatter of the values and QDLDL's numeric pass; the rows of L's pattern too, which QDLDL had
+ * found again in every factorisation by walking the elimination tree (the same arithmetic in the same order: the
+ * same factors to the bit). Whether IW holds this analysis's pattern is
  * recorded in IKEEP (IW's address and LIW when it was built), never read from IW itself: IPOPT allocates IW
  * anew for each analysis and does not clear it, so it may hold what an earlier analysis left there (a header that
  * matched and a stale map once scattered out of bounds: a screen solve's segfault, docs/decisions.md). IW's header
@@ -54,7 +57,7 @@
 #define MATCHED_FROM 1000 /* from this many rows a constraint row waits for its own neighbour (defer_zero_pivots) */
 
 static int ints_needed(int n, int nz, int nnzA, int nnzL) {
-    return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + n + 3 * n + n + nz + (2 * nz + 2 * n);
+    return HDR + (n + 1) + nnzA + (n + 1) + nnzL + n + n + n + 3 * n + n + nz + (n + 1) + nnzL + (2 * nz + 2 * n);
 }
 
 static int doubles_needed(int n, int nz, int nnzA, int nnzL) { return nz + nnzA + nnzL + 4 * n; }
@@ -318,11 +321,12 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
     if (*LA < dneed) { INFO[0] = -4; INFO[1] = dneed; return; }
     int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
     int *Lnz = etree + n, *perm = Lnz + n, *iwork = perm + n, *bwork = iwork + 3 * n, *map = bwork + n;
-    int *scratch = map + nz; /* 2 nz + 2 n */
+    int *Rp = map + nz, *Ri = Rp + (n + 1), *scratch = Ri + nnzL; /* scratch: 2 nz + 2 n */
     if (!(record && built_in(record, IW, *LIW))) {
         if (pattern(n, nz, IRN, ICN, Pinv, Ap, scratch, map) != nnzA) { INFO[0] = -1; return; }
         memcpy(Ai, scratch, sizeof(int) * nnzA);
         if (QDLDL_etree(n, Ap, Ai, iwork, Lnz, etree) != nnzL) { INFO[0] = -1; return; }
+        if (QDLDL_rows(n, Ap, Ai, etree, Rp, Ri, bwork, iwork) != nnzL) { INFO[0] = -1; return; }
         IW[0] = nnzA; IW[1] = nnzL;
         IW[ACCEPTED] = -1; /* nothing solved with yet in this analysis */
         if (record) record_workspace(record, IW, *LIW);
@@ -341,7 +345,7 @@ static void ma27b(int *N, int *NZ, const int *IRN, const int *ICN, double *A, in
         for (j = 0; j < n && limit >= 0; j++)
             if (!bwork[j]) limit = -1;
     }
-    pos = QDLDL_factor(n, Ap, Ai, Ax, Lp, Li, Lx, D, Dinv, Lnz, etree, bwork, iwork, fwork, limit);
+    pos = QDLDL_factor(n, Ap, Ai, Ax, Lp, Li, Lx, D, Dinv, Lnz, Rp, Ri, iwork, fwork, limit);
     INFO[8] = nnzL;
     INFO[9] = nnzL;
     if (pos == -1) { INFO[0] = -5; INFO[1] = n - 1; IW[LAST] = -1; return; }
@@ -353,10 +357,11 @@ static void ma27c(int *N, double *A, int *IW, double *RHS) {
     int n = *N, i;
     int nnzA = IW[0], nnzL = IW[1], nz = IW[2];
     int *Ap = IW + HDR, *Ai = Ap + (n + 1), *Lp = Ai + nnzA, *Li = Lp + (n + 1), *etree = Li + nnzL;
-    int *Lnz = etree + n, *P = Lnz + n, *iwork = P + n, *bwork = iwork + 3 * n;
+    int *Lnz = etree + n, *P = Lnz + n, *iwork = P + n, *bwork = iwork + 3 * n, *map = bwork + n;
+    int *Rp = map + nz, *Ri = Rp + (n + 1);
     double *Ax = A + nz, *Lx = Ax + nnzA, *D = Lx + nnzL, *Dinv = D + n, *fwork = Dinv + n, *x = fwork + n;
     if (IW[LAST] == STOPPED) { /* solved with although stopped early: finish it */
-        int pos = QDLDL_factor(n, Ap, Ai, Ax, Lp, Li, Lx, D, Dinv, Lnz, etree, bwork, iwork, fwork, -1);
+        int pos = QDLDL_factor(n, Ap, Ai, Ax, Lp, Li, Lx, D, Dinv, Lnz, Rp, Ri, iwork, fwork, -1);
         IW[LAST] = pos >= 0 ? n - pos : -1;
     }
     if (IW[LAST] >= 0) IW[ACCEPTED] = IW[LAST];

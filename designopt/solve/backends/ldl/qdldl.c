@@ -23,6 +23,9 @@
  *
  * Changed by designopt (2026-11-28): QDLDL_factor's last argument, maxNegative, stops the factorisation once
  * D has more negative entries than that (return value -2).
+ * Changed by designopt (2026-11-30): the nonzero pattern of each row of L, which QDLDL_factor found by walking
+ * the elimination tree at every factorisation, is found once by QDLDL_rows and given to QDLDL_factor (Rp, Ri);
+ * the factorisation does the same arithmetic in the same order.
  */
 #include "qdldl.h"
 
@@ -94,33 +97,72 @@ QDLDL_int QDLDL_etree(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* A
 }
 
 
+/* The pattern of each row of L, in the order QDLDL_factor eliminates with it: row k's columns are
+ * Ri[Rp[k]] .. Ri[Rp[k + 1] - 1]. Rp has n + 1 entries, Ri as many as L has nonzeros. Returns that count. */
+QDLDL_int QDLDL_rows(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* Ai, const QDLDL_int* etree,
+                     QDLDL_int* Rp, QDLDL_int* Ri, QDLDL_bool* bwork, QDLDL_int* iwork) {
+    QDLDL_int    i, k, t, nnzY, nnzE, bidx, nextIdx;
+    QDLDL_int*   yIdx = iwork;
+    QDLDL_int*   elimBuffer = iwork + n;
+    QDLDL_bool*  yMarkers = bwork;
+
+    for(i = 0; i < n; i++) {
+        yMarkers[i] = QDLDL_UNUSED;
+    }
+    Rp[0] = 0;
+    if(n > 0) {
+        Rp[1] = 0; // the first row of L has no entry left of the diagonal
+    }
+    for(k = 1; k < n; k++) {
+        nnzY = 0;
+        for(i = Ap[k]; i < Ap[k + 1]; i++) {
+            bidx = Ai[i];
+            if(bidx == k || yMarkers[bidx] == QDLDL_USED) {
+                continue;
+            }
+            yMarkers[bidx] = QDLDL_USED;
+            elimBuffer[0] = bidx;
+            nnzE = 1;
+            nextIdx = etree[bidx];
+            while(nextIdx != QDLDL_UNKNOWN && nextIdx < k) {
+                if(yMarkers[nextIdx] == QDLDL_USED)
+                    break;
+                yMarkers[nextIdx] = QDLDL_USED;
+                elimBuffer[nnzE++] = nextIdx;
+                nextIdx = etree[nextIdx];
+            }
+            while(nnzE) {
+                yIdx[nnzY++] = elimBuffer[--nnzE];
+            }
+        }
+        // QDLDL_factor eliminates from the last found to the first
+        for(t = 0; t < nnzY; t++) {
+            Ri[Rp[k] + t] = yIdx[nnzY - 1 - t];
+            yMarkers[yIdx[nnzY - 1 - t]] = QDLDL_UNUSED;
+        }
+        Rp[k + 1] = Rp[k] + nnzY;
+    }
+    return n > 0 ? Rp[n] : 0;
+}
+
+
 QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* Ai,
                        const QDLDL_float* Ax, QDLDL_int* Lp, QDLDL_int* Li, QDLDL_float* Lx,
                        QDLDL_float* D, QDLDL_float* Dinv, const QDLDL_int* Lnz,
-                       const QDLDL_int* etree, QDLDL_bool* bwork, QDLDL_int* iwork,
-                       QDLDL_float* fwork, const QDLDL_int maxNegative) {
+                       const QDLDL_int* Rp, const QDLDL_int* Ri,
+                       QDLDL_int* iwork, QDLDL_float* fwork, const QDLDL_int maxNegative) {
     QDLDL_int    i = 0;
     QDLDL_int    j = 0;
     QDLDL_int    k = 0;
-    QDLDL_int    nnzY = 0;
-    QDLDL_int    bidx = 0;
     QDLDL_int    cidx = 0;
-    QDLDL_int    nextIdx = 0;
-    QDLDL_int    nnzE = 0;
     QDLDL_int    tmpIdx = 0;
-    QDLDL_int*   yIdx;
-    QDLDL_int*   elimBuffer;
     QDLDL_int*   LNextSpaceInCol;
     QDLDL_float* yVals;
     QDLDL_float  yVals_cidx = 0.0;
-    QDLDL_bool*  yMarkers;
     QDLDL_int    positiveValuesInD = 0;
     QDLDL_int    negativeValuesInD = 0;
 
     // Partition working memory into pieces
-    yMarkers = bwork;
-    yIdx = iwork;
-    elimBuffer = iwork + n;
     LNextSpaceInCol = iwork + n * 2;
     yVals = fwork;
 
@@ -131,10 +173,8 @@ QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* 
         // Compute L column indices
         Lp[i + 1] = Lp[i] + Lnz[i]; // cumsum, total at the end
 
-        // Set all Yidx to be 'unused' initially
         // in each column of L, the next available space
         // to start is just the first space in the column
-        yMarkers[i] = QDLDL_UNUSED;
         yVals[i] = 0.0;
         D[i] = 0.0;
         LNextSpaceInCol[i] = Lp[i];
@@ -163,64 +203,21 @@ QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* 
         // The solution y is then the kth row of L,
         // with an implied '1' at the diagonal entry.
 
-        // Number of nonzeros in this row of L
-        nnzY = 0; // Number of elements in this row
-
-        // This loop determines where nonzeros
-        // will go in the kth row of L, but doesn't
-        // compute the actual values
+        // y = b, D[k] = the diagonal entry
         tmpIdx = Ap[k + 1];
 
         for(i = Ap[k]; i < tmpIdx; i++) {
-            bidx = Ai[i]; // We are working on this element of b
-
-            // Initialize D[k] as the element of this column
-            // corresponding to the diagonal place.  Don't use
-            // this element as part of the elimination step
-            // that computes the k^th row of L
-            if(bidx == k) {
+            if(Ai[i] == k) {
                 D[k] = Ax[i];
-                continue;
-            }
-
-            yVals[bidx] = Ax[i]; // Initialise y(bidx) = b(bidx)
-
-            // Use the forward elimination tree to figure
-            // out which elements must be eliminated after
-            // this element of b
-            nextIdx = bidx;
-
-            if(yMarkers[nextIdx] == QDLDL_UNUSED) { // This y term not already visited
-
-                yMarkers[nextIdx] = QDLDL_USED; // I touched this one
-                elimBuffer[0] = nextIdx;        // It goes at the start of the current list
-                nnzE = 1;                       // Length of unvisited elimination path from here
-
-                nextIdx = etree[bidx];
-
-                while(nextIdx != QDLDL_UNKNOWN && nextIdx < k) {
-                    if(yMarkers[nextIdx] == QDLDL_USED)
-                        break;
-
-                    yMarkers[nextIdx] = QDLDL_USED; // I touched this one
-                    elimBuffer[nnzE] = nextIdx;     // It goes in the current list
-                    nnzE++;                         // The list is one longer than before
-                    nextIdx = etree[nextIdx];       // One step further along tree
-
-                }
-
-                // Now I put the buffered elimination list into
-                // my current ordering in reverse order
-                while(nnzE) {
-                    yIdx[nnzY++] = elimBuffer[--nnzE];
-                }
+            } else {
+                yVals[Ai[i]] = Ax[i];
             }
         }
 
-        // This for loop places nonzeros values in the k^th row
-        for(i = (nnzY - 1); i >= 0; i--) {
+        // This for loop places nonzeros values in the k^th row, in the order of QDLDL_rows
+        for(i = Rp[k]; i < Rp[k + 1]; i++) {
             //Which column are we working on?
-            cidx = yIdx[i];
+            cidx = Ri[i];
 
             // Loop along the elements in this
             // column of L and subtract to solve to y
@@ -241,10 +238,8 @@ QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* 
             D[k] -= yVals_cidx * Lx[tmpIdx];
             LNextSpaceInCol[cidx]++;
 
-            // Reset the yvalues and indices back to zero and QDLDL_UNUSED
-            // once I'm done with them
+            // Reset the y value back to zero once I'm done with it
             yVals[cidx] = 0.0;
-            yMarkers[cidx] = QDLDL_UNUSED;
 
         }
 

@@ -98,6 +98,26 @@ QDLDL_API QDLDL_int QDLDL_etree(const QDLDL_int n, const QDLDL_int* Ap, const QD
 
 
 /**
+ * (Added by designopt.) The nonzero pattern of each row of L, in the order QDLDL_factor eliminates with it:
+ * row k's columns are Ri[Rp[k]] .. Ri[Rp[k + 1] - 1]. Depends on the pattern of A only: found once per
+ * pattern, given to every QDLDL_factor of it.
+ *
+ * @param  n      number of columns in A
+ * @param  Ap     column pointers (size n+1) for columns of A (not modified)
+ * @param  Ai     row indices of A.  Has Ap[n] elements (not modified)
+ * @param  etree  elimination tree as given by QDLDL_etree (not modified)
+ * @param  Rp     row pointers (size n+1)
+ * @param  Ri     column indices of each row of L.  Has as many elements as L has nonzeros
+ * @param  bwork  working array of bools. Length is n
+ * @param  iwork  working array of integers. Length is 2*n
+ * @return        the number of nonzeros in L (QDLDL_etree's count)
+ */
+QDLDL_API QDLDL_int QDLDL_rows(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* Ai,
+                               const QDLDL_int* etree, QDLDL_int* Rp, QDLDL_int* Ri, QDLDL_bool* bwork,
+                               QDLDL_int* iwork);
+
+
+/**
  * Compute an LDL decomposition for a quasidefinite matrix
  * in compressed sparse column form, where the input matrix is
  * assumed to contain data for the upper triangular part of A only,
@@ -121,8 +141,9 @@ QDLDL_API QDLDL_int QDLDL_etree(const QDLDL_int n, const QDLDL_int* Ap, const QD
  * @param  Dinv   reciprocal of D.  Length is n
  * @param  Lnz    count of nonzeros in each column of L below diagonal,
  *                as given by QDLDL_etree (not modified)
- * @param  etree  elimination tree as as given by QDLDL_etree (not modified)
- * @param  bwork  working array of bools. Length is n
+ * @param  Rp     row pointers of L's pattern as given by QDLDL_rows (not modified; designopt: in place of
+ *                the elimination tree and the bool work array, which the factorisation walked every time)
+ * @param  Ri     column indices of L's rows as given by QDLDL_rows (not modified)
  * @param  iwork  working array of integers. Length is 3*n
  * @param  fwork  working array of floats. Length is n
  * @param  maxNegative  (added by designopt) stop once D has more negative
@@ -137,7 +158,7 @@ QDLDL_API QDLDL_int QDLDL_etree(const QDLDL_int n, const QDLDL_int* Ap, const QD
 QDLDL_API QDLDL_int QDLDL_factor(const QDLDL_int n, const QDLDL_int* Ap, const QDLDL_int* Ai,
                                  const QDLDL_float* Ax, QDLDL_int* Lp, QDLDL_int* Li,
                                  QDLDL_float* Lx, QDLDL_float* D, QDLDL_float* Dinv,
-                                 const QDLDL_int* Lnz, const QDLDL_int* etree, QDLDL_bool* bwork,
+                                 const QDLDL_int* Lnz, const QDLDL_int* Rp, const QDLDL_int* Ri,
                                  QDLDL_int* iwork, QDLDL_float* fwork, const QDLDL_int maxNegative);
 
 
