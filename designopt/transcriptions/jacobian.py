@@ -46,13 +46,14 @@ def unclaimed_rows(n_g: int, mu_indices: list[np.ndarray]) -> np.ndarray:
     return np.flatnonzero(~claimed)
 
 
-def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: ca.Function,
+def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: ca.Function | None,
                       groups: list[tuple[ca.Function, np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]]
                       ) -> ca.Function:
     """jac_g(x, p) -> (g, dg/dx), for nlpsol's ``jac_g`` option.
 
     ``x``: the NLP's SX decision vector; ``n_g`` its number of constraints and ``g_rows`` (row indices -> SX) their
-    own expressions (only the rows in no group are asked for); ``g_of``: x -> g as a function. Each group is
+    own expressions (only the rows in no group are asked for); ``g_of``: x -> g as a function, or None for a
+    Jacobian whose g output is NaN (`not_computed`). Each group is
     (block, rows, cols, y_index, block_inputs, mu_index) with ``block``, ``rows``, ``cols`` from
     `block_jacobian_function`, ``y_index`` (N x n_y) the position in x of each block variable, ``mu_index``
     (N x n_c) the position in g of each block row and ``block_inputs`` the block's constant extra inputs (mapped).
@@ -81,7 +82,18 @@ def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: 
     rest_fn = ca.Function("jac_rest", [x], [ca.vertcat(*J_rest.nonzeros()) if J_rest.nnz() else ca.SX(0, 1)])
     values.append(rest_fn(X))
     nz = ca.vertcat(*values)[ca.DM(order.tolist())]
-    return ca.Function("jac_g", [X, P], [g_of(X), ca.MX(sp, nz)], ["x", "p"], ["g", "jac_g_x"])
+    g = not_computed(n_g) if g_of is None else g_of(X)
+    return ca.Function("jac_g", [X, P], [g, ca.MX(sp, nz)], ["x", "p"], ["g", "jac_g_x"])
+
+
+def not_computed(n: int) -> ca.MX:
+    """The value output (f or g) of a gradient or Jacobian that only IPOPT reads: NaN.
+
+    nlpsol wants grad_f -> (f, df/dx) and jac_g -> (g, dg/dx), but IPOPT's interface asks for the derivative
+    alone, while an MX function evaluates every node whatever its caller asks for: f and g assembled from the
+    blocks were computed again in every gradient and Jacobian, about 5 % of an exploration iteration
+    (docs/decisions.md, 2026-11-30). NaN, not 0, so that a reader that did use it fails loudly."""
+    return ca.MX(ca.DM.nan(n, 1))
 
 
 def block_gradient_function(terms: ca.Function, compile_mode: str, used: list | None = None) -> ca.Function | None:
@@ -95,12 +107,13 @@ def block_gradient_function(terms: ca.Function, compile_mode: str, used: list | 
     return compiled(ca.Function("block_gradient", [y, *params], [ca.densify(grad)]), compile_mode, used)
 
 
-def assemble_gradient(n_x: int, f_of: ca.Function,
+def assemble_gradient(n_x: int, f_of: ca.Function | None,
                       groups: list[tuple[ca.Function | None, np.ndarray, list]]) -> ca.Function:
     """grad_f(x, p) -> (f, df/dx), for nlpsol's ``grad_f`` option, of f(x) = the sum over the groups' points of
     each group's term at y_k (the per-waypoint phi_k(y_k), the quadratic terms).
 
-    ``n_x``: the length of x; ``f_of``: x -> f. Each group is (block, y_index, block_inputs) with ``block`` the
+    ``n_x``: the length of x; ``f_of``: x -> f, or None for a gradient whose f output is NaN (`not_computed`).
+    Each group is (block, y_index, block_inputs) with ``block`` the
     term's gradient (y, *inputs) -> d/dy (`block_gradient_function`,
     `designopt.transcriptions.quadratic.gradient_groups`; None: no objective term), ``y_index`` (N x n_y) the
     position in x of each block variable and ``block_inputs`` the block's constant extra inputs (mapped).
@@ -117,4 +130,5 @@ def assemble_gradient(n_x: int, f_of: ca.Function,
     # one 1 per column: block entry e adds to entry rows[e] of the gradient
     scatter = ca.DM(ccs_sparsity(n_x, len(rows), rows, np.arange(len(rows))), 1.0)
     grad = ca.mtimes(scatter, ca.vertcat(*values)) if len(rows) else ca.MX(n_x, 1)
-    return ca.Function("grad_f", [X, P], [f_of(X), grad], ["x", "p"], ["f", "grad_f_x"])
+    f = not_computed(1) if f_of is None else f_of(X)
+    return ca.Function("grad_f", [X, P], [f, grad], ["x", "p"], ["f", "grad_f_x"])

@@ -140,8 +140,8 @@ class NLP:
         self.n_design = problem.chain.n_design
         self.blocks, self.quadratic = blocks, quadratic
         self._hessians: dict[str, object] = {}
-        self._jacobians: dict[str, object] = {}
-        self._gradients: dict[str, object] = {}
+        self._jacobians: dict[tuple[str, bool], object] = {}
+        self._gradients: dict[tuple[str, bool], object] = {}
         self._values: dict[str, tuple[ca.Function, ca.Function]] = {}
         self._tiered: dict[str, list] = {}  # per compile mode: the tiered libraries its block functions loaded
 
@@ -188,18 +188,20 @@ class NLP:
                                                             self._constant_hessian)
         return self._hessians[compile_mode]
 
-    def jacobian(self, compile_mode: str):
+    def jacobian(self, compile_mode: str, values: bool = True):
         """jac_g(x, p) -> (g, dg/dx) with the per-point blocks' rows from their (compiled) block Jacobians
-        (`designopt.transcriptions.jacobian`), or None when the NLP has no block structure."""
+        (`designopt.transcriptions.jacobian`), or None when the NLP has no block structure. ``values`` False: g is
+        not computed (NaN; what IPOPT is given, `jacobian.not_computed`)."""
         if self.blocks is None:
             return None
-        if compile_mode not in self._jacobians:
+        if (compile_mode, values) not in self._jacobians:
             groups = [(*block_jacobian_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
                        b.y_index, self._inputs(b), b.mu_index)
                       for b in self.blocks]
-            self._jacobians[compile_mode] = assemble_jacobian(self.x, self.n_constraints, self.constraints.rows,
-                                                              self.functions(compile_mode)[1], groups)
-        return self._jacobians[compile_mode]
+            g_of = self.functions(compile_mode)[1] if values else None
+            self._jacobians[compile_mode, values] = assemble_jacobian(self.x, self.n_constraints,
+                                                                      self.constraints.rows, g_of, groups)
+        return self._jacobians[compile_mode, values]
 
     def functions(self, compile_mode: str) -> tuple[ca.Function, ca.Function]:
         """(x -> f, x -> g), shared by the oracle, grad_f and jac_g. With blocks, both are assembled from the
@@ -219,18 +221,20 @@ class NLP:
                                                              groups, self.quadratic)
         return self._values[compile_mode]
 
-    def gradient(self, compile_mode: str):
+    def gradient(self, compile_mode: str, values: bool = True):
         """grad_f(x, p) -> (f, df/dx): the blocks' dphi/dy scattered, plus the gradient of the quadratic terms
         (`designopt.transcriptions.jacobian.assemble_gradient`; a reverse sweep of the whole objective cost 0.13 s
-        of the main job's 0.35 s build), or None when the NLP has no block structure."""
+        of the main job's 0.35 s build), or None when the NLP has no block structure. ``values`` False: f is not
+        computed (NaN; what IPOPT is given, `jacobian.not_computed`)."""
         if self.blocks is None:
             return None
-        if compile_mode not in self._gradients:
+        if (compile_mode, values) not in self._gradients:
             groups = [(block_gradient_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
                        b.y_index, self._inputs(b)) for b in self.blocks]
-            self._gradients[compile_mode] = assemble_gradient(self.n_variables, self.functions(compile_mode)[0],
-                                                              groups + gradient_groups(self.quadratic))
-        return self._gradients[compile_mode]
+            f_of = self.functions(compile_mode)[0] if values else None
+            self._gradients[compile_mode, values] = assemble_gradient(self.n_variables, f_of,
+                                                                      groups + gradient_groups(self.quadratic))
+        return self._gradients[compile_mode, values]
 
     @functools.cached_property
     def _constant_hessian(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -248,13 +252,14 @@ class NLP:
         """(the NLP for nlpsol, the derivative functions for its options): with blocks, hess_lag, jac_g and
         grad_f are given and the NLP is f and g assembled from the blocks (`functions`), so that nlpsol derives
         nothing itself (it otherwise spends seconds on the SX graph of a cell problem: 6.5 s of the pocket cell's
-        7.3 s build, benchmarks/speed_table.py); without blocks the SX NLP, for nlpsol to differentiate. Every piece
-        is built once per NLP and compile mode and shared by the solvers of all its profiles."""
+        7.3 s build, benchmarks/speed_table.py); jac_g and grad_f without their values, which IPOPT never reads
+        (`jacobian.not_computed`); without blocks the SX NLP, for nlpsol to differentiate. Every piece is built once
+        per NLP and compile mode and shared by the solvers of all its profiles."""
         if self.blocks is None:
             return {"x": self.x, "f": self.f, "g": self.g}, {}
         return self._oracle(compile_mode), {"hess_lag": self.hessian(compile_mode),
-                                            "jac_g": self.jacobian(compile_mode),
-                                            "grad_f": self.gradient(compile_mode)}
+                                            "jac_g": self.jacobian(compile_mode, values=False),
+                                            "grad_f": self.gradient(compile_mode, values=False)}
 
 
 def split_terms(terms: ca.Function) -> tuple[ca.Function | None, ca.Function | None]:

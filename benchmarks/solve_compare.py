@@ -1,0 +1,103 @@
+"""This checkout's library against git revision ``--against``'s on the same solves: the ratio of CPU per IPOPT
+iteration, and whether the solves are the same to the bit.
+
+The revision's ``designopt/`` is exported (``git archive``) to a temporary directory and imported from there
+(``PYTHONPATH``) by the same venv, so a change to the Python library, to a compiled block or to the LDLᵀ's C sources
+(built into the compile cache under their own key) is measured alike, without a second venv. Each round runs, in
+one fresh process per checkout (alternating, so that the machine's load falls on both alike), ``--starts`` seeded
+starts of ``--config`` as the search solves them (``--waypoints`` > 0: the exploration's, capped, watched, by its
+linear solver; 0: cold starts on the full path by the search's profile; `speed_table.setup`), and prints each
+process's CPU per iteration, the iterations and a digest of the objectives and solutions reached: equal digests
+mean the same solves to the bit. At the end, the median over the rounds of the ratio this / against.
+
+    .venv/bin/python benchmarks/solve_compare.py --against HEAD [--config configs/milling.yaml] [--starts 48]
+        [--rounds 8] [--waypoints 10]
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def export(revision: str, out: Path) -> Path:
+    """``revision``'s ``designopt/`` package under ``out`` (for PYTHONPATH)."""
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, "designopt"], check=True,
+                             capture_output=True)
+    subprocess.run(["tar", "-x", "-C", str(out)], input=archive.stdout, check=True)
+    return out
+
+
+def measure(config: str, waypoints: int, starts: int) -> None:
+    """One process's measurement (``--child``): CPU ms per iteration, iterations and the solves' digest."""
+    import numpy as np
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from speed_table import setup
+
+    from designopt.initial_guess import initial_guess
+    from designopt.solve import local
+    from designopt.transcriptions import Collocation
+
+    problem, search = setup(config, waypoints, "explore" if waypoints else "full")
+    built, solver, _ = local.prepared(problem, Collocation(), search.profile)
+    guesses = [built.pack(initial_guess(problem, s, search.seed, search.perturbation, search.init))
+               for s in range(starts)]
+    digest = hashlib.sha256()
+    cpu, iterations = time.process_time(), 0
+    for guess in guesses:
+        outcome = solver.solve(guess)
+        iterations += outcome.iterations
+        digest.update(np.r_[outcome.objective, outcome.x].tobytes())
+    ms = 1000 * (time.process_time() - cpu) / max(iterations, 1)
+    print(f"{ms:.4f} {iterations} {digest.hexdigest()[:12]}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--against", required=False, help="git revision to compare with")
+    parser.add_argument("--config", default="configs/milling.yaml")
+    parser.add_argument("--starts", type=int, default=48)
+    parser.add_argument("--rounds", type=int, default=8)
+    parser.add_argument("--waypoints", type=int, default=10, help="0: the full path")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        measure(args.config, args.waypoints, args.starts)
+        return
+    if not args.against:
+        parser.error("--against REVISION is required")
+    command = [sys.executable, __file__, "--child", "--config", args.config, "--starts", str(args.starts),
+               "--waypoints", str(args.waypoints)]
+    with tempfile.TemporaryDirectory() as tmp:
+        checkouts = (("against", {**os.environ, "PYTHONPATH": str(export(args.against, Path(tmp)))}),
+                     ("this", {**os.environ, "PYTHONPATH": str(ROOT)}))
+        ratios, digests = [], set()
+        for r in range(args.rounds):
+            row = {}
+            for name, env in checkouts:
+                out = subprocess.run(command, check=True, capture_output=True, text=True, cwd=ROOT, env=env)
+                ms, iterations, digest = out.stdout.split()[-3:]
+                row[name] = (float(ms), int(iterations), digest)
+                digests.add((iterations, digest))
+            ratios.append(row["this"][0] / row["against"][0])
+            print(f"round {r + 1}: {args.against} {row['against'][0]:.4f} ms/iter ({row['against'][1]} iterations, "
+                  f"{row['against'][2]}), this {row['this'][0]:.4f} ({row['this'][1]}, {row['this'][2]}): "
+                  f"{ratios[-1]:.3f}x", flush=True)
+    where = f"{args.waypoints} waypoints" if args.waypoints else "the full path"
+    same = "the same solves to the bit" if len(digests) == 1 else "the solves differ"
+    print(f"{args.config}, {args.starts} starts on {where}, {args.rounds} rounds: this / {args.against} per "
+          f"iteration {statistics.median(ratios):.3f}x median ({min(ratios):.3f}-{max(ratios):.3f}); {same}")
+
+
+if __name__ == "__main__":
+    main()
