@@ -27,7 +27,7 @@ from designopt.transcriptions.jacobian import (
     block_jacobian_function,
     unclaimed_rows,
 )
-from designopt.transcriptions.quadratic import QuadraticTerm, constant_hessian, gradient_groups, total
+from designopt.transcriptions.quadratic import QuadraticTerm, compiled_terms, constant_hessian, gradient_groups, total
 
 
 @dataclass(frozen=True)
@@ -206,8 +206,9 @@ class NLP:
     def functions(self, compile_mode: str) -> tuple[ca.Function, ca.Function]:
         """(x -> f, x -> g), shared by the oracle, grad_f and jac_g. With blocks, both are assembled from the
         blocks' own terms (each compiled per ``compile_mode``), mapped over their points, plus the quadratic terms
-        and the constraint rows in no block (`assemble_values`): CasADi's virtual machine interpreting the whole SX
-        graph instead was a fifth of a cell problem's iteration. Without blocks, SX functions of f and g."""
+        (compiled alike) and the constraint rows in no block (`assemble_values`): CasADi's virtual machine
+        interpreting the whole SX graph instead was a fifth of a cell problem's iteration. Without blocks, SX
+        functions of f and g."""
         if compile_mode not in self._values:
             if self.blocks is None:
                 self._values[compile_mode] = (ca.Function("nlp_f", [self.x], [self.f]),
@@ -217,8 +218,9 @@ class NLP:
                                                               self._used(compile_mode))
                              for fn in split_terms(b.terms)),
                            b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
-                self._values[compile_mode] = assemble_values(self.x, self.n_constraints, self.constraints.rows,
-                                                             groups, self.quadratic)
+                self._values[compile_mode] = assemble_values(
+                    self.x, self.n_constraints, self.constraints.rows, groups,
+                    compiled_terms(self.quadratic, compile_mode, self._used(compile_mode)))
         return self._values[compile_mode]
 
     def gradient(self, compile_mode: str, values: bool = True):
@@ -232,8 +234,8 @@ class NLP:
             groups = [(block_gradient_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
                        b.y_index, self._inputs(b)) for b in self.blocks]
             f_of = self.functions(compile_mode)[0] if values else None
-            self._gradients[compile_mode, values] = assemble_gradient(self.n_variables, f_of,
-                                                                      groups + gradient_groups(self.quadratic))
+            quadratic = gradient_groups(self.quadratic, compile_mode, self._used(compile_mode))
+            self._gradients[compile_mode, values] = assemble_gradient(self.n_variables, f_of, groups + quadratic)
         return self._gradients[compile_mode, values]
 
     @functools.cached_property

@@ -12,12 +12,13 @@ scattered like the per-waypoint blocks' (`gradient_groups`, for
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
 
 from designopt.problem import DesignProblem
+from designopt.transcriptions.compiled import compiled, level
 from designopt.transcriptions.hessian import block_symbols, per_point
 from designopt.transcriptions.trajectory import hermite_acceleration_integral
 
@@ -105,11 +106,23 @@ def constant_hessian(terms: tuple[QuadraticTerm, ...]) -> tuple[np.ndarray, np.n
     return rows[keep], cols[keep], values[keep]
 
 
-def gradient_groups(terms: tuple[QuadraticTerm, ...]) -> list[tuple[ca.Function, np.ndarray, list]]:
-    """(y, *params -> dq/dy, y_index, inputs) per term: the groups `assemble_gradient` scatters."""
+def gradient_groups(terms: tuple[QuadraticTerm, ...], compile_mode: str = "none",
+                    used: list | None = None) -> list[tuple[ca.Function, np.ndarray, list]]:
+    """(y, *params -> dq/dy, y_index, inputs) per term: the groups `assemble_gradient` scatters, each gradient
+    compiled as a block of as many points would be (`compiled.level` of ``compile_mode``; ``used``:
+    `compiled.compiled_as`)."""
     groups = []
     for term in terms:
         y, params = block_symbols(term.fn)
         gradient = ca.Function("quadratic_gradient", [y, *params], [ca.densify(ca.gradient(term.fn(y, *params), y))])
-        groups.append((gradient, term.y_index, list(term.inputs)))
+        groups.append((compiled(gradient, level(compile_mode, len(term.y_index)), used), term.y_index,
+                       list(term.inputs)))
     return groups
+
+
+def compiled_terms(terms: tuple[QuadraticTerm, ...], compile_mode: str,
+                   used: list | None = None) -> tuple[QuadraticTerm, ...]:
+    """The terms with their functions compiled as blocks of as many points would be (`compiled.level` of
+    ``compile_mode``), for evaluating f: interpreted, they and their gradients were most of what CasADi's virtual
+    machine still ran in a solve (the same values to the bit, docs/decisions.md, 2026-11-30)."""
+    return tuple(replace(term, fn=compiled(term.fn, level(compile_mode, len(term.y_index)), used)) for term in terms)
