@@ -191,16 +191,18 @@ class NLP:
     def jacobian(self, compile_mode: str, values: bool = True):
         """jac_g(x, p) -> (g, dg/dx) with the per-point blocks' rows from their (compiled) block Jacobians
         (`designopt.transcriptions.jacobian`), or None when the NLP has no block structure. ``values`` False: g is
-        not computed (NaN; what IPOPT is given, `jacobian.not_computed`)."""
+        not computed (NaN; what IPOPT is given, `jacobian.not_computed`); True: that function with g added."""
         if self.blocks is None:
             return None
         if (compile_mode, values) not in self._jacobians:
-            groups = [(*block_jacobian_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
-                       b.y_index, self._inputs(b), b.mu_index)
-                      for b in self.blocks]
-            g_of = self.functions(compile_mode)[1] if values else None
-            self._jacobians[compile_mode, values] = assemble_jacobian(self.x, self.n_constraints,
-                                                                      self.constraints.rows, g_of, groups)
+            if values:
+                jacobian = _with_value(self.jacobian(compile_mode, False), self.functions(compile_mode)[1])
+            else:
+                groups = [(*block_jacobian_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
+                           b.y_index, self._inputs(b), b.mu_index)
+                          for b in self.blocks]
+                jacobian = assemble_jacobian(self.x, self.n_constraints, self.constraints.rows, None, groups)
+            self._jacobians[compile_mode, values] = jacobian
         return self._jacobians[compile_mode, values]
 
     def functions(self, compile_mode: str) -> tuple[ca.Function, ca.Function]:
@@ -227,15 +229,18 @@ class NLP:
         """grad_f(x, p) -> (f, df/dx): the blocks' dphi/dy scattered, plus the gradient of the quadratic terms
         (`designopt.transcriptions.jacobian.assemble_gradient`; a reverse sweep of the whole objective cost 0.13 s
         of the main job's 0.35 s build), or None when the NLP has no block structure. ``values`` False: f is not
-        computed (NaN; what IPOPT is given, `jacobian.not_computed`)."""
+        computed (NaN; what IPOPT is given, `jacobian.not_computed`); True: that function with f added."""
         if self.blocks is None:
             return None
         if (compile_mode, values) not in self._gradients:
-            groups = [(block_gradient_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
-                       b.y_index, self._inputs(b)) for b in self.blocks]
-            f_of = self.functions(compile_mode)[0] if values else None
-            quadratic = gradient_groups(self.quadratic, compile_mode, self._used(compile_mode))
-            self._gradients[compile_mode, values] = assemble_gradient(self.n_variables, f_of, groups + quadratic)
+            if values:
+                gradient = _with_value(self.gradient(compile_mode, False), self.functions(compile_mode)[0])
+            else:
+                groups = [(block_gradient_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
+                           b.y_index, self._inputs(b)) for b in self.blocks]
+                quadratic = gradient_groups(self.quadratic, compile_mode, self._used(compile_mode))
+                gradient = assemble_gradient(self.n_variables, None, groups + quadratic)
+            self._gradients[compile_mode, values] = gradient
         return self._gradients[compile_mode, values]
 
     @functools.cached_property
@@ -262,6 +267,14 @@ class NLP:
         return self._oracle(compile_mode), {"hess_lag": self.hessian(compile_mode),
                                             "jac_g": self.jacobian(compile_mode, values=False),
                                             "grad_f": self.gradient(compile_mode, values=False)}
+
+
+def _with_value(derivative: ca.Function, value_of: ca.Function) -> ca.Function:
+    """A gradient or Jacobian (x, p) -> (NaN, derivative) as (x, p) -> (value, derivative), ``value_of``: x -> the
+    value: the blocks' derivatives derived once for both."""
+    X, P = (ca.MX.sym(derivative.name_in(i), derivative.sparsity_in(i)) for i in range(2))
+    return ca.Function(derivative.name(), [X, P], [value_of(X), derivative(X, P)[1]], derivative.name_in(),
+                       derivative.name_out())
 
 
 def split_terms(terms: ca.Function) -> tuple[ca.Function | None, ca.Function | None]:
