@@ -297,7 +297,7 @@ MUTATIONS = [
              "            rows.append(y_index.ravel())", "            rows.append(np.roll(y_index, 1, axis=0).ravel())",
              ("tests/test_transcriptions.py", "tests/test_clearance.py")),
     Mutation("the quadratic terms left out of the gradient", "designopt/transcriptions/nlp.py",
-             "f_of, groups + quadratic)", "f_of, groups)",
+             "None, groups + quadratic)", "None, groups)",
              ("tests/test_transcriptions.py", "tests/test_clearance.py")),
     Mutation("the constraints from blocks put in the wrong rows", "designopt/transcriptions/nlp.py",
              "np.zeros(0, int)])] = np.arange(n_g)", "np.zeros(0, int)])] = np.roll(np.arange(n_g), 1)",
