@@ -77,7 +77,7 @@ POLISH = 10  # damped least-squares iterations without the pull that finish a wa
 
 
 def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, iterations: int = 30,
-                  home_pull: float = 0.0) -> np.ndarray:
+                  home_pull: float = 0.0, waypoints: int | None = None) -> np.ndarray:
     """Damped least-squares IK along the path from ``q0``, each waypoint starting from the previous solution; with
     ``home_pull`` > 0 (`HOME_PULL` for ``init: home``), the redundancy resolved towards the first waypoint's
     configuration (the *home* posture).
@@ -95,7 +95,8 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
     where they began; pulled, 27 of 27). Where dr/dq has no null space, or only joints the walk never moves (a
     last joint turning about the tool axis), the walk is the minimum-norm walk to the bit wherever that reaches the
     path (residual below 1e-7) within its iterations; at a waypoint it does not reach (an arm with too few joints
-    for the path, a point out of reach) the `POLISH` iterations walk on, so the start differs there too."""
+    for the path, a point out of reach) the `POLISH` iterations walk on, so the start differs there too.
+    ``waypoints``: walk only the first that many (None: all); each row is the full walk's to the bit."""
     fn = point_residual(problem)
     points = problem.toolpath.points_W
 
@@ -113,11 +114,11 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
 
     lo = np.array([j.lower for j in problem.chain.moving])
     hi = np.array([j.upper for j in problem.chain.moving])
-    Q = np.empty((problem.toolpath.n, len(q0)))
+    Q = np.empty((problem.toolpath.n if waypoints is None else min(waypoints, problem.toolpath.n), len(q0)))
     q = np.array(q0, dtype=float)
     home = None  # the first waypoint's own configuration, once walked to (the first waypoint is walked unpulled)
     eye = np.eye(len(q))
-    for k in range(problem.toolpath.n):
+    for k in range(len(Q)):
         damping, pull = 1e-2, home_pull if k else 0.0
         r, J = residual(q, k)
         pulled = iterations if k == 0 else max(8, iterations // 3)
@@ -334,16 +335,7 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
         raise ValueError(f"init must be one of {INIT_MODES}, got {mode!r}")
     if spread not in SPREADS:
         raise ValueError(f"spread must be one of {SPREADS}, got {spread!r}")
-    rng = np.random.default_rng([seed, index])
-    if spread == "mixed":
-        spread = "box" if index % 2 else "perturb"
-    if design is not None:
-        q_d = within_bounds(problem, design)
-    elif index == 0:
-        q_d = problem.chain.design_values
-    else:
-        q_d = perturbed_design(problem, rng, scale) if spread == "perturb" else box_design(problem, rng)
-    q0 = random_configuration(problem, rng, np.pi / 2 if spread == "perturb" else np.pi)
+    q_d, q0 = _drawn(problem, index, seed, scale, design, spread)
     if mode == "constant":
         return InitialGuess(q_d=q_d, Q=np.tile(q0, (problem.toolpath.n, 1)), seed=start_number(seed, index))
     pull = HOME_PULL if mode == "home" else 0.0
@@ -357,6 +349,33 @@ def initial_guess(problem: DesignProblem, index: int, seed: int, scale: float, m
         if not tracks(problem, q_d, Q):
             q_d, Q = reach(problem, q_d, Q)
     return InitialGuess(q_d=q_d, Q=Q, seed=start_number(seed, index))
+
+
+def _drawn(problem: DesignProblem, index: int, seed: int, scale: float, design: np.ndarray | None,
+           spread: str) -> tuple[np.ndarray, np.ndarray]:
+    """Start ``index`` of ``seed``'s design and the configuration its walk starts from (`initial_guess`)."""
+    rng = np.random.default_rng([seed, index])
+    if spread == "mixed":
+        spread = "box" if index % 2 else "perturb"
+    if design is not None:
+        q_d = within_bounds(problem, design)
+    elif index == 0:
+        q_d = problem.chain.design_values
+    else:
+        q_d = perturbed_design(problem, rng, scale) if spread == "perturb" else box_design(problem, rng)
+    return q_d, random_configuration(problem, rng, np.pi / 2 if spread == "perturb" else np.pi)
+
+
+def first_configuration(problem: DesignProblem, index: int, seed: int, scale: float, mode: str = "ik",
+                        design: np.ndarray | None = None, spread: str = "perturb") -> np.ndarray:
+    """Where start ``index`` of ``seed`` (`initial_guess`, the same arguments) reaches the path's first waypoint:
+    the first row of its walk (``reach``: of its first walk), to the bit, for the cost of that waypoint's IK alone
+    (rad for revolute joints, m for prismatic ones; the draw itself for ``constant``, which does not walk). Which
+    branch a walk is on shows there first (`designopt.solve.starts.spread_branches`)."""
+    q_d, q0 = _drawn(problem, index, seed, scale, design, spread)
+    if mode == "constant":
+        return q0
+    return ik_trajectory(problem, q_d, q0, home_pull=HOME_PULL if mode == "home" else 0.0, waypoints=1)[0]
 
 
 def design_from(problem: DesignProblem, other: DesignProblem, q_d_other: np.ndarray) -> np.ndarray:

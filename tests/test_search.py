@@ -22,6 +22,7 @@ from designopt.experiments.adapters import search_from_config, structure_config
 from designopt.initial_guess import (
     _moved_onto_path,
     beyond_reach,
+    first_configuration,
     ik_trajectory,
     initial_guess,
     projected,
@@ -47,7 +48,7 @@ from designopt.solve import (
     solve_one,
 )
 from designopt.solve.optima import design_forms, form_joints
-from designopt.solve.starts import Rebranched
+from designopt.solve.starts import Rebranched, spread_branches
 from designopt.solve.strategies import coarse_to_fine
 from designopt.solve.strategies.coarse_to_fine import (
     coarse_problem,
@@ -435,6 +436,69 @@ def test_the_second_rounds_leaders_get_their_starts_by_rank():
     even = rebranched_tasks([[(task, s) for s in sols]], replace(shared, rebranch_shares=None))
     assert [t.start.solution for t in even] == [sols[0]] * 2 + [sols[1]] * 2 + [sols[2]] * 2
     assert "restarted 2 times each" in replace(shared, rebranch_shares=None).describe()
+
+
+def test_a_walks_first_configuration_is_its_first_row_to_the_bit():
+    """`initial_guess.first_configuration` walks the first waypoint alone: the first row of the whole walk to the bit,
+    for plain and pulled walks, seeded and rebranched starts (independent truth: the walk itself)."""
+    problem = coarse_problem(problem_from_config(parse_config({})), 6)
+    design = problem.chain.design_values + 0.05
+    for mode in ("ik", "home"):
+        for index in range(4):
+            rebranched = Rebranched(SimpleNamespace(raw=SimpleNamespace(q_d=design)), 3, index, mode)
+            assert np.array_equal(rebranched.first_configuration(problem), rebranched.guess(problem).Q[0])
+            seeded = initial_guess(problem, index, 3, 0.3, mode)
+            assert np.array_equal(first_configuration(problem, index, 3, 0.3, mode), seeded.Q[0])
+    assert not np.array_equal(first_configuration(problem, 1, 3, 0.3), first_configuration(problem, 2, 3, 0.3))
+
+
+def test_branches_spread_by_farthest_points_one_from_each_cluster():
+    """`spread_branches`: the first row, then the row farthest from all taken, revolute differences wrapped (a
+    configuration at pi - 0.01 rad is next to one at -pi + 0.01), prismatic ones in m; never a row twice."""
+    rng = np.random.default_rng(0)
+    centres = np.array([[0.0, 0.0, 0.3], [2.0, -2.0, 0.3], [-2.0, 2.0, 0.8]])
+    rows = np.vstack([c + 0.05 * rng.standard_normal((5, 3)) for c in centres])  # clusters of 5, in order
+    angle = np.array([True, True, False])
+    taken = spread_branches(rows, 3, angle)
+    assert taken[0] == 0 and sorted(k // 5 for k in taken) == [0, 1, 2]
+    wrapped = np.array([[np.pi - 0.01, 0.0], [-np.pi + 0.01, 0.0], [0.0, 0.0]])
+    assert spread_branches(wrapped, 2, np.array([True, True])) == [0, 2]
+    assert spread_branches(wrapped, 2, np.array([False, False])) == [0, 1]  # unwrapped, the two are 2 pi apart
+    assert spread_branches(np.zeros((4, 2)), 4, np.array([True, True])) == [0, 1, 2, 3]
+    assert spread_branches(rows, 40, angle) == [0, *spread_branches(rows, 15, angle)[1:]] and len(
+        set(spread_branches(rows, 40, angle))) == 15
+    assert spread_branches(rows, 0, angle) == []
+
+
+def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
+    """``rebranch_pool``: each leader's starts drawn that many times over, in a block of start numbers of its own
+    (`Search.round_start` counts the pool), the ones taken spread over the branches their walks reach first
+    (`spread_branches` of the first configurations), the first drawn always among them; 1: the starts as before.
+    Numbers that would reach the reflect step's are refused."""
+    problem = problem_from_config(parse_config({}))
+    coarse = coarse_problem(problem, 6)
+    a, b = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0)
+    sols = [_optimum(coarse, 1.0, a, 0.0), _optimum(coarse, 2.0, b, 0.0)]
+    task = Task("", "explore", coarse, Collocation(), SolverProfile(), Seeded(0, 0))
+    plain = Search(starts=6, rebranch=2, seed=4, init="home")
+    pooled = replace(plain, rebranch_pool=3)
+    before = rebranched_tasks([[(task, s) for s in sols]], plain)
+    assert [t.start.index for t in before] == list(range(6, 12))
+    after = rebranched_tasks([[(task, s) for s in sols]], pooled)
+    assert pooled.round_start(0) == 6 and pooled.round_start(1) == 6 + 3 * 6
+    assert [t.start.solution for t in after] == [sols[0]] * 3 + [sols[1]] * 3
+    first, second = [t.start.index for t in after[:3]], [t.start.index for t in after[3:]]
+    assert first[0] == 6 and second[0] == 15 and first == sorted(first) and second == sorted(second)
+    assert set(first) <= set(range(6, 15)) and set(second) <= set(range(15, 24))
+    for leader, taken in ((sols[0], first), (sols[1], second)):
+        pool = [Rebranched(leader, 4, j, "home") for j in range(taken[0], taken[0] + 9)]
+        firsts = np.array([s.first_configuration(coarse) for s in pool])
+        angle = np.array([j.kind == "angle" for j in coarse.chain.moving])
+        assert taken == sorted(taken[0] + k for k in spread_branches(firsts, 3, angle))
+    assert all(pooled.second_round(t.seed) for t in after)
+    assert "3x as many drawn" in pooled.describe()
+    with pytest.raises(ValueError, match="numbered past 900"):
+        next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_pool=5)))
 
 
 def test_a_later_round_on_new_joint_branches_starts_from_the_best_of_every_round_before_it():

@@ -46,7 +46,9 @@ class Search:
     leader of rank k as many times as its k-th entry, where there is one: `leader_starts`) on
     a new joint branch (the optimum's design, first joints drawn over the whole circle:
     `designopt.solve.starts.Rebranched`; 0: none), explored alike (``rebranch_rounds`` > 1: that many such rounds,
-    each from the best of every round before it, sharing ``starts // rebranch`` per leader); the
+    each from the best of every round before it, sharing ``starts // rebranch`` per leader; ``rebranch_pool`` > 1:
+    a leader's starts taken from that many times as many drawn, spread over the branches where their walks reach
+    the path's first waypoint, `starts.spread_branches`); the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
     cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
     more waypoints), and the
@@ -92,6 +94,7 @@ class Search:
     rebranch_new_forms: int = 0
     rebranch_shares: tuple[int, ...] | None = None
     rebranch_rounds: int = 1
+    rebranch_pool: int = 1
     screen_waypoints: int = 40
     screen: int = 12
     screen_per_form: int | None = None
@@ -133,9 +136,10 @@ class Search:
 
     def round_start(self, r: int) -> int:
         """The first start index of round ``r`` on new joint branches (0: the second round of the exploration):
-        ``most_starts``, then one block per round, as large as a round can be (every leader's starts)."""
+        ``most_starts``, then one block per round, as large as a round can be (every leader's starts, each drawn
+        from a pool ``rebranch_pool`` times as large)."""
         leaders = self.rebranch + self.rebranch_new_forms
-        return self.most_starts + r * sum(self.leader_starts(k) for k in range(leaders))
+        return self.most_starts + r * self.rebranch_pool * sum(self.leader_starts(k) for k in range(leaders))
 
     def second_round(self, number):
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,
@@ -199,6 +203,9 @@ class Search:
                  f"{', '.join(str(n) for n in self.rebranch_shares)} times by rank")
         if self.rebranch_rounds > 1:
             times += f", in {self.rebranch_rounds} rounds, each from the best of every round before it,"
+        if self.rebranch_pool > 1:
+            times += (f" (spread over the branches of {self.rebranch_pool}x as many drawn, by their first "
+                      f"waypoint's configuration)")
         again = (f", the best {self.rebranch} distinct{per_form} restarted {times} on a new joint branch"
                  if self.rebranch else "")
         kkt = self._kkt((self.explore_linear_solver,))

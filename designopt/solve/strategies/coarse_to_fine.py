@@ -31,10 +31,13 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 from designopt.problem import DesignProblem
 from designopt.solve.optima import best_solution, distinct_best
 from designopt.solve.search import Searched, by_job
-from designopt.solve.starts import Lifted, Rebranched
+from designopt.solve.starts import Lifted, Rebranched, spread_branches
+from designopt.solve.strategies import reflect
 from designopt.solve.strategies.steps import numbered_stage, seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
@@ -126,7 +129,10 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     ``search.leader_starts(rank)`` (``starts // rebranch`` unless ``rebranch_shares``) times on a new joint branch,
     as the task that found it (the same coarse problem, profile and continuation); start indices follow the
     exploration's, one after the other from round ``round_``'s block (`Search.round_start`; round 0 from
-    ``search.most_starts``)."""
+    ``search.most_starts``). With ``search.rebranch_pool`` > 1 a leader's starts are drawn that many times over
+    (the indices of its block) and the ones taken spread over the branches where their walks reach the first
+    waypoint (`starts.spread_branches`; the first drawn always among them), in index order; the others are
+    never solved and their numbers stay unused."""
     tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
@@ -134,13 +140,22 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
         index = search.round_start(round_)
         for k, i in enumerate(leaders):
             first, sol = done[i]
-            for _ in range(search.leader_starts(k)):
-                tasks.append(replace(first, start=Rebranched(sol, search.seed, index, search.init)))
-                index += 1
+            n = search.leader_starts(k)
+            drawn = range(index, index + n * search.rebranch_pool)
+            pool = [Rebranched(sol, search.seed, j, search.init) for j in drawn]
+            if search.rebranch_pool > 1:
+                angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
+                firsts = np.array([start.first_configuration(first.problem) for start in pool])
+                pool = [pool[j] for j in sorted(spread_branches(firsts, n, angle))]
+            tasks += [replace(first, start=start) for start in pool]
+            index += n * search.rebranch_pool
     return tasks
 
 
 def plan(jobs, search):
+    if search.rebranch and search.round_start(search.rebranch_rounds) > reflect.FIRST_START:
+        raise ValueError(f"the exploration's starts would be numbered past {reflect.FIRST_START}, where the reflect "
+                         f"step's begin: fewer starts, leaders or a smaller rebranch_pool")
     explore = []
     for job, starts in zip(jobs, exploration_starts([job.problem for job in jobs], search), strict=True):
         coarse = coarse_problem(job.problem, search.explore_waypoints)
