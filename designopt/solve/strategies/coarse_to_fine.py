@@ -37,7 +37,7 @@ from designopt.problem import DesignProblem
 from designopt.solve.optima import best_solution, distinct_best
 from designopt.solve.search import Searched, by_job
 from designopt.solve.starts import Lifted, Rebranched, spread_branches
-from designopt.solve.strategies import reflect
+from designopt.solve.strategies.reflect import FIRST_START
 from designopt.solve.strategies.steps import numbered_stage, seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
@@ -153,8 +153,8 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
 
 
 def plan(jobs, search):
-    if search.rebranch and search.round_start(search.rebranch_rounds) > reflect.FIRST_START:
-        raise ValueError(f"the exploration's starts would be numbered past {reflect.FIRST_START}, where the reflect "
+    if search.rebranch and search.round_start(search.rebranch_rounds) > FIRST_START:
+        raise ValueError(f"the exploration's starts would be numbered past {FIRST_START}, where the reflect "
                          f"step's begin: fewer starts, leaders or a smaller rebranch_pool")
     explore = []
     for job, starts in zip(jobs, exploration_starts([job.problem for job in jobs], search), strict=True):
