@@ -83,8 +83,8 @@ class Rebranched(Numbered):
                              "box")
 
     def first_configuration(self, problem: DesignProblem) -> np.ndarray:
-        """Where this start's walk reaches the path's first waypoint (`guess`'s first row, for a tenth of its
-        cost: `initial_guess.first_configuration`)."""
+        """Where this start's walk reaches the path's first waypoint (`guess`'s first row, for a fraction of its cost:
+        `initial_guess.first_configuration`; a seventh on the main job's 10 waypoints)."""
         return first_configuration(problem, self.index, self.seed, 0.0, self.init,
                                    np.asarray(self.solution.raw.q_d, float), "box")
 
