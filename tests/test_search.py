@@ -501,6 +501,52 @@ def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
         next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_pool=5)))
 
 
+def test_rows_kept_then_the_rest_spread_farthest_from_them():
+    """`spread_branches(..., kept=k)`: the first k rows taken as they are, then each time the row farthest from every
+    one taken; kept=1 is the plain farthest-point sampling."""
+    rng = np.random.default_rng(1)
+    centres = np.array([[0.0, 0.0], [2.0, -2.0], [-2.0, 2.0], [2.5, 2.5]])
+    rows = np.vstack([c + 0.05 * rng.standard_normal((4, 2)) for c in centres])  # clusters of 4, in order
+    angle = np.array([False, False])
+    taken = spread_branches(rows, 7, angle, kept=4)  # the first cluster kept whole: one row of each other cluster
+    assert taken[:4] == [0, 1, 2, 3] and sorted(k // 4 for k in taken[4:]) == [1, 2, 3]
+    assert spread_branches(rows, 5, angle, kept=1) == spread_branches(rows, 5, angle)
+    assert spread_branches(rows, 3, angle, kept=8) == [0, 1, 2]  # never more than count
+
+
+def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_they_miss():
+    """``rebranch_extra``: each leader's drawn starts stay (the same numbers), and that many more join them, taken
+    from ``rebranch_extra_pool`` drawn in a block after every round's (`Search.extra_start`) by `spread_branches`
+    kept at the drawn ones' first configurations. Numbers that would reach the reflect step's are refused."""
+    problem = problem_from_config(parse_config({}))
+    coarse = coarse_problem(problem, 6)
+    a, b = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0)
+    sols = [_optimum(coarse, 1.0, a, 0.0), _optimum(coarse, 2.0, b, 0.0)]
+    task = Task("", "explore", coarse, Collocation(), SolverProfile(), Seeded(0, 0))
+    plain = Search(starts=6, rebranch=2, seed=4, init="home")
+    extra = replace(plain, rebranch_extra=2, rebranch_extra_pool=5)
+    before = rebranched_tasks([[(task, s) for s in sols]], plain)
+    after = rebranched_tasks([[(task, s) for s in sols]], extra)
+    assert extra.extra_start(0, 0) == 12 and extra.extra_start(0, 1) == 17 and extra.last_exploration_start == 22
+    assert [t.start.solution for t in after] == [sols[0]] * 5 + [sols[1]] * 5
+    indices = [t.start.index for t in after]
+    assert indices[:3] == [t.start.index for t in before[:3]] and indices[5:8] == [t.start.index for t in before[3:]]
+    angle = np.array([j.kind == "angle" for j in coarse.chain.moving])
+    for k, (leader, mine) in enumerate(((sols[0], indices[:5]), (sols[1], indices[5:]))):
+        drawn = [Rebranched(leader, 4, j, "home") for j in mine[:3]]
+        pool = [Rebranched(leader, 4, j, "home") for j in range(extra.extra_start(0, k), extra.extra_start(0, k) + 5)]
+        firsts = np.array([s.first_configuration(coarse) for s in drawn + pool])
+        chosen = spread_branches(firsts, 5, angle, kept=3)[3:]
+        assert mine[3:] == sorted(extra.extra_start(0, k) + j - 3 for j in chosen)
+    assert all(extra.second_round(t.seed) for t in after)
+    assert "and 2 more spread over the branches those miss (of 5 drawn)" in extra.describe()
+    assert "more spread" not in plain.describe()
+    next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_extra=5)))  # 360 + 400 <= 900
+    with pytest.raises(ValueError, match="numbered past 900"):
+        next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_extra=5,
+                                                             rebranch_extra_pool=60)))
+
+
 def test_a_later_round_on_new_joint_branches_starts_from_the_best_of_every_round_before_it():
     """``rebranch_rounds``: the rounds on new joint branches share the first round's count (``starts // (rebranch x
     rounds)`` per leader), each from the best distinct optima of every round before it, numbered in blocks from

@@ -48,7 +48,9 @@ class Search:
     `designopt.solve.starts.Rebranched`; 0: none), explored alike (``rebranch_rounds`` > 1: that many such rounds,
     each from the best of every round before it, sharing ``starts // rebranch`` per leader; ``rebranch_pool`` > 1:
     a leader's starts taken from that many times as many drawn, spread over the branches where their walks reach
-    the path's first waypoint, `starts.spread_branches`); the
+    the path's first waypoint, `starts.spread_branches`; ``rebranch_extra`` > 0: that many starts more per leader,
+    spread over the branches its drawn ones miss, out of ``rebranch_extra_pool`` drawn in a block of their own,
+    `extra_start`); the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
     cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
     more waypoints), and the
@@ -95,6 +97,8 @@ class Search:
     rebranch_shares: tuple[int, ...] | None = None
     rebranch_rounds: int = 1
     rebranch_pool: int = 1
+    rebranch_extra: int = 0
+    rebranch_extra_pool: int = 40
     screen_waypoints: int = 40
     screen: int = 12
     screen_per_form: int | None = None
@@ -140,6 +144,23 @@ class Search:
         from a pool ``rebranch_pool`` times as large)."""
         leaders = self.rebranch + self.rebranch_new_forms
         return self.most_starts + r * self.rebranch_pool * sum(self.leader_starts(k) for k in range(leaders))
+
+    def extra_start(self, r: int, rank: int) -> int:
+        """The first start index of the ``rebranch_extra_pool`` drawn for the extra starts of round ``r``'s leader
+        of ``rank`` (`rebranch_extra`): after every round's block (`round_start`), one block of that size per leader
+        and round, so that the leaders' drawn starts keep the numbers they have without extras."""
+        leaders = self.rebranch + self.rebranch_new_forms
+        return self.round_start(self.rebranch_rounds) + (r * leaders + rank) * self.rebranch_extra_pool
+
+    @property
+    def last_exploration_start(self) -> int:
+        """One past the largest start index the exploration can use: the rounds' blocks and, with
+        ``rebranch_extra``, the extras' (`extra_start`)."""
+        if not self.rebranch:
+            return self.most_starts
+        if self.rebranch_extra:
+            return self.extra_start(self.rebranch_rounds, 0)
+        return self.round_start(self.rebranch_rounds)
 
     def second_round(self, number):
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,
@@ -206,6 +227,9 @@ class Search:
         if self.rebranch_pool > 1:
             times += (f" (spread over the branches of {self.rebranch_pool}x as many drawn, by their first "
                       f"waypoint's configuration)")
+        if self.rebranch_extra:
+            times += (f" and {self.rebranch_extra} more spread over the branches those miss (of "
+                      f"{self.rebranch_extra_pool} drawn)")
         again = (f", the best {self.rebranch} distinct{per_form} restarted {times} on a new joint branch"
                  if self.rebranch else "")
         kkt = self._kkt((self.explore_linear_solver,))

@@ -89,17 +89,19 @@ class Rebranched(Numbered):
                                    np.asarray(self.solution.raw.q_d, float), "box")
 
 
-def spread_branches(configurations: np.ndarray, count: int, angle: np.ndarray) -> list[int]:
+def spread_branches(configurations: np.ndarray, count: int, angle: np.ndarray, kept: int = 1) -> list[int]:
     """Indices of ``count`` of ``configurations`` (one per row) spread over the joint space by farthest-point
-    sampling: the first row, then each time the row farthest from every one taken (Euclidean over the joints,
-    revolute differences wrapped to [-pi, pi] rad, prismatic ones in m; ``angle`` marks the revolute columns), ties
-    to the lower index. Rebranched walks funnel into a few branches (on the circle two sign patterns of the first
-    configuration held 79 of 256 walks and none of the best basin's), so starts taken this way from a larger pool
-    cover more branches than as many drawn at random (`Search.rebranch_pool`)."""
+    sampling: the first ``kept`` rows (at least one), then each time the row farthest from every one taken
+    (Euclidean over the joints, revolute differences wrapped to [-pi, pi] rad, prismatic ones in m; ``angle`` marks
+    the revolute columns), ties to the lower index. Rebranched walks funnel into a few branches (on the circle two
+    sign patterns of the first configuration held 79 of 256 walks and none of the best basin's), so starts taken
+    this way from a larger pool cover more branches than as many drawn at random (`Search.rebranch_pool`); with
+    ``kept`` the starts already drawn, those added cover the branches they miss (`Search.rebranch_extra`)."""
     X = np.asarray(configurations, float)
     count = min(count, len(X))
     if count <= 0:
         return []
+    kept = min(max(kept, 1), count)
 
     def distance(i):
         d = X - X[i]
@@ -107,8 +109,11 @@ def spread_branches(configurations: np.ndarray, count: int, angle: np.ndarray) -
         return np.sqrt((d * d).sum(axis=1))
 
     taken, nearest = [0], distance(0)
-    nearest[0] = -np.inf  # never taken twice, even where every row left is a copy of one taken
-    for _ in range(count - 1):
+    for i in range(1, kept):
+        taken.append(i)
+        nearest = np.minimum(nearest, distance(i))
+    nearest[taken] = -np.inf  # never taken twice, even where every row left is a copy of one taken
+    for _ in range(count - kept):
         i = int(np.argmax(nearest))
         taken.append(i)
         nearest = np.minimum(nearest, distance(i))

@@ -133,7 +133,9 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     ``search.most_starts``). With ``search.rebranch_pool`` > 1 a leader's starts are drawn that many times over
     (the indices of its block) and the ones taken spread over the branches where their walks reach the first
     waypoint (`starts.spread_branches`; the first drawn always among them), in index order; the others are
-    never solved and their numbers stay unused."""
+    never solved and their numbers stay unused. With ``search.rebranch_extra`` > 0 each leader gets that many
+    starts more, spread over the branches its starts miss: taken farthest from them (and from each other) out of
+    ``search.rebranch_extra_pool`` drawn from `Search.extra_start`, after its own starts, in index order."""
     tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
@@ -144,17 +146,24 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
             n = search.leader_starts(k)
             drawn = range(index, index + n * search.rebranch_pool)
             pool = [Rebranched(sol, search.seed, j, search.init) for j in drawn]
+            angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
             if search.rebranch_pool > 1:
-                angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
                 firsts = np.array([start.first_configuration(first.problem) for start in pool])
                 pool = [pool[j] for j in sorted(spread_branches(firsts, n, angle))]
+            if search.rebranch_extra > 0:
+                begin = search.extra_start(round_, k)
+                extras = [Rebranched(sol, search.seed, j, search.init)
+                          for j in range(begin, begin + search.rebranch_extra_pool)]
+                firsts = np.array([start.first_configuration(first.problem) for start in pool + extras])
+                taken = spread_branches(firsts, len(pool) + search.rebranch_extra, angle, kept=len(pool))
+                pool = pool + [extras[j - len(pool)] for j in sorted(taken[len(pool):])]
             tasks += [replace(first, start=start) for start in pool]
             index += n * search.rebranch_pool
     return tasks
 
 
 def plan(jobs, search):
-    if search.rebranch and search.round_start(search.rebranch_rounds) > FIRST_START:
+    if search.rebranch and search.last_exploration_start > FIRST_START:
         raise ValueError(f"the exploration's starts would be numbered past {FIRST_START}, where the reflect "
                          f"step's begin: fewer starts, leaders or a smaller rebranch_pool")
     explore = []
