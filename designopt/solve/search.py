@@ -348,9 +348,14 @@ PRESETS: dict[str, Search] = {
     # 1.238 -> 1.211x), at 0.99-1.02x the solve time (docs/benchmarks.md, "IK walks pulled home"). The first reflect
     # round over every refined optimum within 1.05x of the best (`reflect_within`): on seeds never run before (main
     # job 1587-1606, the other two 1484-1503), replays of the default's runs, seeds better / worse 5 / 0, 3 / 0, 1 / 0
-    # at 1.006x, 1.036x, 1.017x the solve time (docs/benchmarks.md, "Runner-up optima reflected")
+    # at 1.006x, 1.036x, 1.017x the solve time (docs/benchmarks.md, "Runner-up optima reflected"). Each second-round
+    # leader's 20 drawn starts kept and 5 more spread over the branches they miss (`rebranch_extra`): on seeds never
+    # run before (circle 1544-1563, physical stiffness 1544-1553, main job 1687-1696), replays of the default's runs,
+    # seeds better / worse 5 / 0, 4 / 0, 2 / 0 at 1.066x, 1.079x, 1.085x the solve time (docs/benchmarks.md, "Five more
+    # starts per leader")
     "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
-                      refine_mu_init=(None, 1e-6), rebranch_new_forms=2, reflect=3, reflect_within=1.05),
+                      refine_mu_init=(None, 1e-6), rebranch_new_forms=2, reflect=3, reflect_within=1.05,
+                      rebranch_extra=5),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
