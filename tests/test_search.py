@@ -470,16 +470,21 @@ def test_branches_spread_by_farthest_points_one_from_each_cluster():
     assert spread_branches(rows, 0, angle) == []
 
 
+def _two_leaders():
+    """The main job, its 6-waypoint coarse problem, two coarse optima of two forms on it and an exploration task."""
+    problem = problem_from_config(parse_config({}))
+    coarse = coarse_problem(problem, 6)
+    a, b = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0)
+    sols = [_optimum(coarse, 1.0, a, 0.0), _optimum(coarse, 2.0, b, 0.0)]
+    return problem, coarse, sols, Task("", "explore", coarse, Collocation(), SolverProfile(), Seeded(0, 0))
+
+
 def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
     """``rebranch_pool``: each leader's starts drawn that many times over, in a block of start numbers of its own
     (`Search.round_start` counts the pool), the ones taken spread over the branches their walks reach first
     (`spread_branches` of the first configurations), the first drawn always among them; 1: the starts as before.
     Numbers that would reach the reflect step's are refused."""
-    problem = problem_from_config(parse_config({}))
-    coarse = coarse_problem(problem, 6)
-    a, b = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0)
-    sols = [_optimum(coarse, 1.0, a, 0.0), _optimum(coarse, 2.0, b, 0.0)]
-    task = Task("", "explore", coarse, Collocation(), SolverProfile(), Seeded(0, 0))
+    problem, coarse, sols, task = _two_leaders()
     plain = Search(starts=6, rebranch=2, seed=4, init="home")
     pooled = replace(plain, rebranch_pool=3)
     before = rebranched_tasks([[(task, s) for s in sols]], plain)
@@ -518,11 +523,7 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
     """``rebranch_extra``: each leader's drawn starts stay (the same numbers), and that many more join them, taken
     from ``rebranch_extra_pool`` drawn in a block after every round's (`Search.extra_start`) by `spread_branches`
     kept at the drawn ones' first configurations. Numbers that would reach the reflect step's are refused."""
-    problem = problem_from_config(parse_config({}))
-    coarse = coarse_problem(problem, 6)
-    a, b = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0)
-    sols = [_optimum(coarse, 1.0, a, 0.0), _optimum(coarse, 2.0, b, 0.0)]
-    task = Task("", "explore", coarse, Collocation(), SolverProfile(), Seeded(0, 0))
+    problem, coarse, sols, task = _two_leaders()
     plain = Search(starts=6, rebranch=2, seed=4, init="home")
     extra = replace(plain, rebranch_extra=2, rebranch_extra_pool=5)
     before = rebranched_tasks([[(task, s) for s in sols]], plain)

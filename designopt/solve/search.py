@@ -138,19 +138,22 @@ class Search:
         follow them."""
         return math.ceil(self.starts * max(self.small_problem_starts, 1.0))
 
+    @property
+    def leaders(self) -> int:
+        """The most leaders a round on new joint branches has: ``rebranch`` and ``rebranch_new_forms``."""
+        return self.rebranch + self.rebranch_new_forms
+
     def round_start(self, r: int) -> int:
         """The first start index of round ``r`` on new joint branches (0: the second round of the exploration):
         ``most_starts``, then one block per round, as large as a round can be (every leader's starts, each drawn
         from a pool ``rebranch_pool`` times as large)."""
-        leaders = self.rebranch + self.rebranch_new_forms
-        return self.most_starts + r * self.rebranch_pool * sum(self.leader_starts(k) for k in range(leaders))
+        return self.most_starts + r * self.rebranch_pool * sum(self.leader_starts(k) for k in range(self.leaders))
 
     def extra_start(self, r: int, rank: int) -> int:
         """The first start index of the ``rebranch_extra_pool`` drawn for the extra starts of round ``r``'s leader
         of ``rank`` (`rebranch_extra`): after every round's block (`round_start`), one block of that size per leader
         and round, so that the leaders' drawn starts keep the numbers they have without extras."""
-        leaders = self.rebranch + self.rebranch_new_forms
-        return self.round_start(self.rebranch_rounds) + (r * leaders + rank) * self.rebranch_extra_pool
+        return self.round_start(self.rebranch_rounds) + (r * self.leaders + rank) * self.rebranch_extra_pool
 
     @property
     def last_exploration_start(self) -> int:

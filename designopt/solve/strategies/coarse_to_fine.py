@@ -148,14 +148,16 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
             drawn = range(index, index + n * search.rebranch_pool)
             pool = [Rebranched(sol, search.seed, j, search.init) for j in drawn]
             angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
-            if search.rebranch_pool > 1:
+            if search.rebranch_pool > 1 or search.rebranch_extra > 0:
                 firsts = np.array([start.first_configuration(first.problem) for start in pool])
-                pool = [pool[j] for j in sorted(spread_branches(firsts, n, angle))]
+            if search.rebranch_pool > 1:
+                chosen = sorted(spread_branches(firsts, n, angle))
+                pool, firsts = [pool[j] for j in chosen], firsts[chosen]
             if search.rebranch_extra > 0:
                 begin = search.extra_start(round_, k)
                 extras = [Rebranched(sol, search.seed, j, search.init)
                           for j in range(begin, begin + search.rebranch_extra_pool)]
-                firsts = np.array([start.first_configuration(first.problem) for start in pool + extras])
+                firsts = np.vstack([firsts, [start.first_configuration(first.problem) for start in extras]])
                 taken = spread_branches(firsts, len(pool) + search.rebranch_extra, angle, kept=len(pool))
                 pool = pool + [extras[j - len(pool)] for j in sorted(taken[len(pool):])]
             tasks += [replace(first, start=start) for start in pool]
@@ -166,7 +168,7 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
 def plan(jobs, search):
     if search.rebranch and search.last_exploration_start > FIRST_START:
         raise ValueError(f"the exploration's starts would be numbered past {FIRST_START}, where the reflect "
-                         f"step's begin: fewer starts, leaders or a smaller rebranch_pool")
+                         f"step's begin: fewer starts, leaders or a smaller rebranch_pool or rebranch_extra_pool")
     explore = []
     for job, starts in zip(jobs, exploration_starts([job.problem for job in jobs], search), strict=True):
         coarse = coarse_problem(job.problem, search.explore_waypoints)
