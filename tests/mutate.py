@@ -602,23 +602,27 @@ def run_tests(tree: Path, cache: Path, tests: list[str]) -> tuple[bool, str]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", help="run only mutations whose name contains this text")
+    parser.add_argument("--from", dest="first", type=int, default=1, metavar="K",
+                        help="start at mutation K, numbered as a run without it prints them (to finish a run cut "
+                             "short)")
     parser.add_argument("--tests", nargs="+", default=TESTS, help="test files to run (default: the fast ones "
                                                                   "that guard the objective)")
     args = parser.parse_args()
     chosen = [m for m in MUTATIONS if not args.only or args.only in m.name]
+    numbered = list(enumerate(chosen, 1))[max(args.first, 1) - 1:]
     with tempfile.TemporaryDirectory(prefix="designopt-mutate-") as tmp:
         tmp = Path(tmp)
         cache, clean = tmp / "cache", tmp / "clean"
         copy_project(clean)
         start = time.perf_counter()
-        targeted = [t for m in chosen if m.tests and args.tests == TESTS for t in m.tests]
+        targeted = [t for _, m in numbered if m.tests and args.tests == TESTS for t in m.tests]
         ok, summary = run_tests(clean, cache, list(dict.fromkeys([*args.tests, *targeted])))
         print(f"baseline (no mutation): {'green' if ok else 'RED'} in {time.perf_counter() - start:.0f} s: {summary}")
         if not ok:
             print("the unmutated suite fails: fix it before judging mutations")
             return 2
         survived = 0
-        for i, m in enumerate(chosen, 1):
+        for i, m in numbered:
             tree = tmp / f"m{i}"
             shutil.copytree(clean, tree)
             path = tree / m.file
@@ -634,7 +638,9 @@ def main() -> int:
             verdict = "SURVIVED" if passed else "caught  "
             print(f"[{i:2d}] {verdict} {m.name} ({time.perf_counter() - start:.0f} s): {summary}", flush=True)
             shutil.rmtree(tree)
-        print(f"{len(chosen) - survived} of {len(chosen)} mutations caught, {survived} survived")
+        print(f"{len(numbered) - survived} of {len(numbered)} mutations caught, {survived} survived"
+              + (f" (mutations {numbered[0][0]}-{numbered[-1][0]} of {len(chosen)})" if numbered and args.first > 1
+                 else ""))
     return 1 if survived else 0
 
 
