@@ -69,7 +69,8 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert search_from_config(parse_config({})) == PRESETS["default"]
     assert PRESETS["default"] == Search(starts=160, screen=24, init="home", explore_linear_solver="ldl",
                                         screen_mu_init=(None, 1e-6), refine_mu_init=(None, 1e-6),
-                                        rebranch_new_forms=2, reflect=3, reflect_within=1.05, rebranch_extra=5)
+                                        rebranch_new_forms=2, reflect=3, reflect_within=1.05, rebranch_extra=15,
+                                        rebranch_extra_pool=50)
     for name in PRESETS:
         assert search_from_config(parse_config({"search": {"preset": name}})) == PRESETS[name]
     changed = search_from_config(parse_config({"search": {"preset": "paper", "seed": 7, "starts": 3}}))
@@ -542,10 +543,9 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
     assert all(extra.second_round(t.seed) for t in after)
     assert "and 2 more spread over the branches those miss (of 5 drawn)" in extra.describe()
     assert "more spread" not in plain.describe()
-    next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_extra=5)))  # 360 + 400 <= 900
+    next(coarse_to_fine.plan([Job("", problem)], preset("default")))  # 360 + 10 x 50 <= 900
     with pytest.raises(ValueError, match="numbered past 900"):
-        next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_extra=5,
-                                                             rebranch_extra_pool=60)))
+        next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_extra_pool=60)))
 
 
 def test_a_later_round_on_new_joint_branches_starts_from_the_best_of_every_round_before_it():

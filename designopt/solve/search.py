@@ -355,10 +355,12 @@ PRESETS: dict[str, Search] = {
     # leader's 20 drawn starts kept and 5 more spread over the branches they miss (`rebranch_extra`): on seeds never
     # run before (circle 1544-1563, physical stiffness 1544-1553, main job 1687-1696), replays of the default's runs,
     # seeds better / worse 5 / 0, 4 / 0, 2 / 0 at 1.066x, 1.079x, 1.085x the solve time (docs/benchmarks.md, "Five more
-    # starts per leader")
+    # starts per leader"); 15 such starts (of 50 drawn) instead of 5: on seeds never run before (circle 1564-1573,
+    # physical stiffness 1554-1563, main job 1697-1706), replays of the default's runs, seeds better / worse 1 / 0,
+    # 3 / 0, 3 / 0 at 1.149x, 1.137x, 1.170x the solve time (docs/benchmarks.md, "Fifteen more starts per leader")
     "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
                       refine_mu_init=(None, 1e-6), rebranch_new_forms=2, reflect=3, reflect_within=1.05,
-                      rebranch_extra=5),
+                      rebranch_extra=15, rebranch_extra_pool=50),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
