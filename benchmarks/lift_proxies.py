@@ -8,7 +8,7 @@ lifts, none of which solves anything:
     walk    the IK walk along the finer path from the coarse trajectory's first configuration, its design cost
 
     .venv/bin/python benchmarks/search_seeds.py --first-seed 7 --seeds 1 --set search.starts=160 --out DIR
-    .venv/bin/python benchmarks/lift_proxies.py DIR/milling/s7 --config configs/milling.yaml
+    .venv/bin/python benchmarks/lift_proxies.py DIR/milling/s7
 
 Prints, per ranking, its Spearman correlation with the screen's cost, where the screen's best (within 5 %) ranks,
 and the best screen cost among the first 12 and 24 of the ranking (the default search screens 12); with
@@ -77,13 +77,15 @@ def predictions_and_screen(task) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("run", type=Path, help="a finished run's directory (its solutions/explore-*.json)")
-    parser.add_argument("--config", type=Path, default=Path("configs/milling.yaml"))
+    parser.add_argument("--config", type=Path, help="the run's config (default: the run's own config.yaml, whose "
+                        "solver.seed numbers its starts; without one, configs/milling.yaml)")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--dump", type=Path, help="write every coarse optimum's row (costs, designs) as JSON here")
     parser.add_argument("--reference", type=float, help="a design cost on the screen's waypoints to count against "
                         "(e.g. the best design known solved there)")
     args = parser.parse_args()
-    cfg = load_config(args.config)
+    own = args.run / "config.yaml"
+    cfg = load_config(args.config or (own if own.exists() else Path("configs/milling.yaml")))
     problem, search = problem_from_config(cfg), search_from_config(cfg)
     coarse = coarse_problem(problem, search.explore_waypoints)
     files = sorted(args.run.glob("solutions/explore-*.json"))
