@@ -16,7 +16,7 @@ design optimal for the full path. Stages, each across every problem:
    With ``rebranch_rounds`` > 1 the rounds on new joint branches share those starts, each round from the best
    distinct optima of every round before it; with ``rebranch_pool`` > 1 a leader's starts are drawn that many times
    over and those kept spread over the branches their walks reach first; with ``rebranch_extra`` > 0 (the default's
-   15) a leader's drawn starts all stay and that many more join them, spread over the branches they miss.
+   30) a leader's drawn starts all stay and that many more join them, spread over the branches they miss.
 2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem of several more,
    on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter``
