@@ -47,9 +47,9 @@ from designopt.solve import (
     solve_guess,
     solve_one,
 )
-from designopt.solve.optima import design_forms, form_joints
+from designopt.solve.optima import arm_joints, cluster_designs, design_forms, form_joints
 from designopt.solve.starts import Rebranched, spread_branches
-from designopt.solve.strategies import coarse_to_fine
+from designopt.solve.strategies import coarse_to_fine, reflect
 from designopt.solve.strategies.coarse_to_fine import (
     coarse_problem,
     exploration_starts,
@@ -1012,3 +1012,58 @@ def test_a_solve_given_a_bound_stops_at_it_with_its_status(milling_12):
     assert held.raw.objective > 0.5 * free.raw.objective
     again = solve_guess(problem, Collocation(), profile, guess, bound=Bound(100.0 * free.raw.objective, 20))
     assert again.raw.status == "Solve_Succeeded" and again.raw.iterations == free.raw.iterations
+
+
+def _placed_elsewhere(solution, cost: float, **moves):
+    """``solution``'s stand-in with the same arm, its placement joints moved by ``moves`` (name: amount, metres or
+    radians), at design cost ``cost``."""
+    chain = solution.problem.chain
+    q = solution.raw.q_d.copy()
+    for name, amount in moves.items():
+        q[[j.name for j in chain.design].index(f"placement.{name}")] += amount
+    return SimpleNamespace(problem=solution.problem, metrics=SimpleNamespace(tracks=True, design_cost=cost),
+                           raw=SimpleNamespace(q_d=q))
+
+
+def test_the_same_arm_placed_elsewhere_at_the_same_cost_is_one_optimum():
+    """``same_arm_cost``: an optimum whose arm (every design joint but the placement's, `arm_joints`) lies within
+    ``tol`` of a cheaper one's and whose cost is within that fraction of it joins it, however far its placement
+    (a copy turned about a circle's axis); a cost further off, an arm moved by more than ``tol``, or an arm
+    without design joints (a fixed robot's placements: a tie in cost alone) keeps them apart; None: as before."""
+    problem = problem_from_config(parse_config({}))
+    chain = problem.chain
+    arm = arm_joints(chain)
+    names = [j.name for j in chain.design]
+    assert [n for n, a in zip(names, arm, strict=True) if not a] == [n for n in names if n.startswith("placement.")]
+    assert arm.sum() == len(names) - 6
+    best = _optimum(problem, 1.0, (0, 0, 1, 0, 1), 0.0)
+    sols = [best,
+            _placed_elsewhere(best, 1.0015, yaw=2.1, x=-0.3),  # a copy: the same arm, 0.15 % dearer
+            _placed_elsewhere(best, 1.01, yaw=2.1),  # the same arm 1 % dearer: another optimum
+            _optimum(problem, 1.0005, (0, 0, 1, 0, 1), 0.1),  # another arm at the same cost
+            _placed_elsewhere(_optimum(problem, 1.0, (0, 0, 1, 0, 1), 0.015), 1.001, y=0.4)]  # arm 15 mm off
+    assert distinct_best(sols, 10) == [0, 3, 4, 1, 2]
+    assert distinct_best(sols, 10, same_arm_cost=0.002) == [0, 3, 2]
+    assert distinct_best(sols, 2, same_arm_cost=0.002) == [0, 3]
+    assert distinct_best(sols, 10, same_arm_cost=0.02) == [0, 3]
+    costs = np.array([s.metrics.design_cost for s in sols])
+    designs = np.array([s.raw.q_d for s in sols])
+    angle = np.array([j.kind == "angle" for j in chain.design])
+    assert list(cluster_designs(designs, costs, angle, 0.02, arm, 0.002)) == [0, 0, 2, 1, 0]
+
+    placed = problem_from_config(parse_config({"design": ["placement"]}))
+    assert not arm_joints(placed.chain).any()
+    fixed = [SimpleNamespace(problem=placed, metrics=SimpleNamespace(tracks=True, design_cost=1.0 + 1e-4 * k),
+                             raw=SimpleNamespace(q_d=placed.chain.design_values + 0.3 * k)) for k in range(3)]
+    assert distinct_best(fixed, 3, same_arm_cost=0.002) == [0, 1, 2]
+
+    task = Task("", "explore", problem, Collocation(), SolverProfile(), Seeded(0, 0))
+    search = Search(starts=6, rebranch=3, same_arm_cost=0.002)
+    tasks = rebranched_tasks([[(task, s) for s in sols]], search)
+    assert [t.start.solution for t in tasks[:: search.rebranch_starts]] == [sols[0], sols[3], sols[2]]
+    screened = coarse_to_fine.lifted_tasks([Job("", problem)], [[(task, s) for s in sols]], 3, "screen", None, search)
+    assert [t.start.solution for t in screened] == [sols[0], sols[3], sols[2]]
+    assert reflect.leading(sols, best, 1.005, search) == [sols[0], sols[3]]
+    assert reflect.leading(sols, best, 1.005, Search()) == [sols[0], sols[3], sols[4], sols[1]]
+    assert "the same arm within 0.2% of a cheaper one's cost one optimum" in search.describe()
+    assert "the same arm" not in Search().describe()

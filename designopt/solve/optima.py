@@ -23,21 +23,32 @@ def design_distance(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> float:
     return float(design_distances(a, b, angle))
 
 
-def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, tol: float = 0.02) -> np.ndarray:
+def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, tol: float = 0.02,
+                    arm: np.ndarray | None = None, same_arm_cost: float | None = None) -> np.ndarray:
     """Label each design with its local optimum: in order of cost, a design joins the first (cheaper) cluster
     whose representative lies within ``tol`` (m or rad) in every design joint (`design_distance`), else starts a
-    new one. Each design is compared with every representative at once: a search's 320 coarse optima, most of
-    them distinct, took ~50,000 pairwise calls (0.4 s) between two of its stages, while the workers waited."""
+    new one. With ``same_arm_cost`` (a fraction) it also joins a cluster whose representative's arm -- the design
+    joints marked in ``arm`` (`arm_joints`) -- lies within ``tol`` and whose cost it exceeds by at most that
+    fraction: the same arm at the same cost, placed elsewhere (without design joints in the arm, a fixed robot's
+    placements, a tie in cost alone is no such evidence: not merged). Each design is compared with every representative
+    at once: a search's 320 coarse optima, most of them distinct, took ~50,000 pairwise calls (0.4 s) between two
+    of its stages, while the workers waited."""
     designs = np.asarray(designs, float).reshape(len(costs), -1)
+    costs = np.asarray(costs, float)
     order = np.argsort(costs, kind="stable")
     labels, leaders, n = np.empty(len(costs), dtype=int), np.empty_like(designs), 0
+    leader_costs = np.empty(len(costs))
     for i in order:
         if n:
-            near = np.flatnonzero(design_distances(designs[i], leaders[:n], angle) <= tol)
+            close = design_distances(designs[i], leaders[:n], angle) <= tol
+            if same_arm_cost is not None and arm is not None and arm.any():
+                arm_close = design_distances(designs[i][arm], leaders[:n, arm], angle[arm]) <= tol
+                close |= arm_close & (costs[i] <= (1 + same_arm_cost) * leader_costs[:n])
+            near = np.flatnonzero(close)
             if near.size:
                 labels[i] = near[0]
                 continue
-        labels[i], leaders[n] = n, designs[i]
+        labels[i], leaders[n], leader_costs[n] = n, designs[i], costs[i]
         n += 1
     return labels
 
@@ -52,6 +63,14 @@ def form_joints(chain) -> np.ndarray:
     return np.array([chain.joints[i].kind == "angle" and i in inner for i in design], dtype=bool)
 
 
+def arm_joints(chain) -> np.ndarray:
+    """Which design joints make the arm: every design joint but the placement's (the walk from the robot base to
+    the workpiece, ``chain.placement``). The same arm placed elsewhere differs from itself only outside this mask."""
+    placement = {et.joint for et in chain.placement}
+    design = [i for i, j in enumerate(chain.joints) if j.role is Role.DESIGN]
+    return np.array([i not in placement for i in design], dtype=bool)
+
+
 def design_forms(designs: np.ndarray, form: np.ndarray) -> list[tuple[int, ...]]:
     """Each design's form: its design angles marked in ``form`` (`form_joints`), each 0 near a multiple of pi
     (consecutive joint axes parallel, for a twist) or 1 near an odd multiple of pi/2 (perpendicular) -- the
@@ -61,13 +80,14 @@ def design_forms(designs: np.ndarray, form: np.ndarray) -> list[tuple[int, ...]]
 
 
 def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int | None = None,
-                  new_forms: int = 0) -> list[int]:
+                  new_forms: int = 0, same_arm_cost: float | None = None) -> list[int]:
     """Indices into ``solutions`` of the best tracking solution of each of the ``count`` cheapest distinct
     optima (`cluster_designs`), cheapest first. ``per_form``: at most this many optima of one form
     (`design_forms`) before the optima of other forms, cheapest first; then, if fewer than ``count`` are taken,
     the cheapest of the rest (None: by cost alone; a design space without form joints has one form, and is
     taken by cost alone too). ``new_forms``: then, beyond the ``count``, the cheapest optimum of each of up to
-    this many forms not among them, cheapest first."""
+    this many forms not among them, cheapest first. ``same_arm_cost``: the same arm within that fraction of a
+    cheaper optimum's cost is that optimum (`cluster_designs`; None: designs compared joint by joint only)."""
     tracking = [i for i, s in enumerate(solutions) if s.metrics.tracks]
     if not tracking or count <= 0:
         return []
@@ -75,7 +95,7 @@ def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int 
     angle = np.array([j.kind == "angle" for j in chain.design], dtype=bool)
     costs = np.array([solutions[i].metrics.design_cost for i in tracking])
     designs = np.array([solutions[i].raw.q_d for i in tracking]).reshape(len(tracking), -1)
-    labels = cluster_designs(designs, costs, angle, tol)
+    labels = cluster_designs(designs, costs, angle, tol, arm_joints(chain), same_arm_cost)
     leaders = {}
     for k in np.argsort(costs, kind="stable"):
         leaders.setdefault(labels[k], k)

@@ -55,9 +55,13 @@ class Search:
     cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
     more waypoints), and the
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
-    design joint are one optimum. ``hold_degenerate``: a solve stalled on a degenerate design is finished with
-    the design held there (`strategies.continuation`). ``structure_neighbours``: after the strategy, one more
-    start per problem from each neighbouring structure's better design (`strategies.neighbours`; problems whose
+    design joint are one optimum; with ``same_arm_cost``, so are two whose arms (every design joint but the
+    placement's) lie within ``distinct`` and whose design costs within that fraction of the cheaper's: the same arm
+    placed elsewhere (a path's symmetry turns a placement about a circle's axis; a flat valley slides it), one
+    leader, candidate or reflected optimum, not several (`optima.cluster_designs`). ``hold_degenerate``: a solve
+    stalled on a degenerate design is finished with the design held there (`strategies.continuation`).
+    ``structure_neighbours``: after the strategy, one more start per problem from each neighbouring structure's
+    better design (`strategies.neighbours`; problems whose
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
     solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None: the
     profile's; `SolverProfile.linear_solver`); ``screen_linear_solver``: the screen's, each candidate screened once
@@ -105,6 +109,7 @@ class Search:
     screen_max_iter: int = 300
     refine: int = 4
     distinct: float = 0.02
+    same_arm_cost: float | None = None
     hold_degenerate: bool = True
     structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
@@ -240,9 +245,11 @@ class Search:
         if self.small_problem_starts > 1:
             drawn += (f" (a problem smaller than the largest up to {self.small_problem_starts:g}x as many, "
                       f"about its cost)")
+        same = (f"; the same arm within {self.same_arm_cost:.1%} of a cheaper one's cost one optimum"
+                if self.same_arm_cost is not None else "")
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
-                f"refined on the full path ({cap}{barrier}){reflect}{held}{solver}")
+                f"refined on the full path ({cap}{barrier}){reflect}{same}{held}{solver}")
 
     def _repeated(self) -> str:
         """Which arms the screen's passes after the first are for, in words (`passes_for`)."""

@@ -104,7 +104,8 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     for job, done in zip(jobs, found, strict=True):
         problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
         profile, continuation = solve_setup(job, search, warm)
-        for i in distinct_best([sol for _, sol in done], count, search.distinct, per_form):
+        for i in distinct_best([sol for _, sol in done], count, search.distinct, per_form,
+                               same_arm_cost=search.same_arm_cost):
             tasks.append(Task(job.case, stage, problem, job.transcription, profile, Lifted(done[i][1]), continuation))
     return tasks
 
@@ -140,7 +141,7 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
-                                search.rebranch_new_forms)
+                                search.rebranch_new_forms, search.same_arm_cost)
         index = search.round_start(round_)
         for k, i in enumerate(leaders):
             first, sol = done[i]

@@ -46,7 +46,7 @@ def plan(searched: list[Searched], search):
     for i in range(search.reflect):
         bests = [best_solution([sol for _, sol in done]) for done in final]
         within = search.reflect_within if i == 0 else None  # later rounds: the new best alone
-        tasks = reflected_tasks([(job, leading([sol for _, sol in done], best, within, search.distinct))
+        tasks = reflected_tasks([(job, leading([sol for _, sol in done], best, within, search))
                                  for job, done, best, last in zip(jobs, final, bests, looked_at, strict=True)
                                  if best is not None and best is not last], numbered_stage(STAGE, i), search)
         if not tasks:
@@ -61,13 +61,15 @@ def plan(searched: list[Searched], search):
     return [Searched(s.job, s.explore, f) for s, f in zip(searched, final, strict=True)]
 
 
-def leading(solutions, best, within: float | None, distinct: float) -> list:
+def leading(solutions, best, within: float | None, search) -> list:
     """The optima a round reflects: ``best`` (the best of ``solutions``) alone when ``within`` is None, else every
-    distinct optimum among ``solutions`` (`optima.distinct_best`, ``distinct`` apart) whose design cost is within
-    that factor of ``best``'s, cheapest first (``best`` among them)."""
+    distinct optimum among ``solutions`` (`optima.distinct_best`: ``search.distinct`` apart, the same arm within
+    ``search.same_arm_cost`` of a cheaper one's cost one optimum) whose design cost is within that factor of
+    ``best``'s, cheapest first (``best`` among them)."""
     if within is None:
         return [best]
-    optima = [solutions[k] for k in distinct_best(solutions, len(solutions), distinct)]
+    optima = [solutions[k] for k in distinct_best(solutions, len(solutions), search.distinct,
+                                                  same_arm_cost=search.same_arm_cost)]
     return [s for s in optima if s.metrics.design_cost <= within * best.metrics.design_cost]
 
 
