@@ -1,12 +1,13 @@
 """Which of a run's screen candidates are the same arm placed elsewhere, and what the screen takes without them.
 
 For each RUN (a directory `search_seeds.py --out DIR` keeps, DIR/<name>/s<seed>) this reads the exploration's
-coarse optima back (both rounds), picks the screen's candidates as the run's search did (`optima.distinct_best`,
-its config's search) and as it would with ``--same-arm-cost`` (`Search.same_arm_cost`: two optima whose arms lie
-within ``distinct`` and whose costs within that fraction of the cheaper's are one), and prints: how many of the
-run's candidates repeat a cheaper candidate's arm at such a cost (copies), the start numbers the merge brings in
-and leaves out, and the rank of the candidate the run's answer came from in both lists (an answer from a reflect
-start is not traced back).
+coarse optima back (both rounds), picks the screen's candidates (`optima.distinct_best`, its config's search) with
+designs compared joint by joint (``same_arm_cost`` None) and with ``--same-arm-cost`` (`Search.same_arm_cost`: two
+optima whose arms lie within ``distinct`` and whose costs within that fraction of the cheaper's are one), and
+prints: how many of the joint-by-joint candidates repeat a cheaper candidate's arm at such a cost (copies), the
+start numbers the merge brings in and leaves out, and the rank of the candidate the run's answer came from in both
+lists (an answer from a reflect start is not traced back). Run on a run of a search that merged already, the first
+list is what it would have screened without.
 
     .venv/bin/python benchmarks/same_arm.py DIR/circle_standoff/s* --same-arm-cost 0.002
 """
@@ -66,8 +67,7 @@ def main() -> None:
         starts = [task.seed for task, _ in found]
         sols = [sol for _, sol in found]
         merged = replace(search, same_arm_cost=args.same_arm_cost)
-        before = [starts[i] for i in distinct_best(sols, search.screen, search.distinct,
-                                                   same_arm_cost=search.same_arm_cost)]
+        before = [starts[i] for i in distinct_best(sols, search.screen, search.distinct)]
         after = [starts[i] for i in distinct_best(sols, merged.screen, merged.distinct,
                                                   same_arm_cost=merged.same_arm_cost)]
         picked = [starts.index(s) for s in before]
