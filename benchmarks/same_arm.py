@@ -25,25 +25,22 @@ from stage_solvers import solved
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
 from designopt.problem import problem_from_config
-from designopt.solve.optima import arm_joints, design_distances, distinct_best
+from designopt.solve.optima import arm_joints, cluster_designs, distinct_best
 from designopt.solve.search import Job
 from designopt.tables import stage_kind
 
 
 def copies(sols: list, picked: list[int], search, same_arm_cost: float) -> int:
-    """How many of the ``picked`` solutions (cheapest first) repeat an earlier one's arm within ``search.distinct``
-    at a design cost within ``same_arm_cost`` of it."""
-    chain = sols[picked[0]].problem.chain if picked else None
-    if chain is None:
+    """How many of the ``picked`` solutions (distinct designs, cheapest first) the merge of ``same_arm_cost`` joins
+    to a cheaper one (`optima.cluster_designs`)."""
+    if not picked:
         return 0
-    arm = arm_joints(chain)
-    angle = np.array([j.kind == "angle" for j in chain.design], dtype=bool)[arm]
-    count = 0
-    for k, i in enumerate(picked):
-        a, c = sols[i].raw.q_d[arm], sols[i].metrics.design_cost
-        count += any(design_distances(a, sols[j].raw.q_d[arm], angle) <= search.distinct
-                     and c <= (1 + same_arm_cost) * sols[j].metrics.design_cost for j in picked[:k])
-    return count
+    chain = sols[picked[0]].problem.chain
+    angle = np.array([j.kind == "angle" for j in chain.design], dtype=bool)
+    labels = cluster_designs(np.array([sols[i].raw.q_d for i in picked]),
+                             np.array([sols[i].metrics.design_cost for i in picked]), angle, search.distinct,
+                             arm_joints(chain), same_arm_cost)
+    return len(picked) - len(set(labels))
 
 
 def rank(origin: int | None, ranked: list[int], starts: list[int]) -> str:

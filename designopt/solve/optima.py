@@ -38,10 +38,11 @@ def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, t
     order = np.argsort(costs, kind="stable")
     labels, leaders, n = np.empty(len(costs), dtype=int), np.empty_like(designs), 0
     leader_costs = np.empty(len(costs))
+    merge = same_arm_cost is not None and arm is not None and arm.any()
     for i in order:
         if n:
             close = design_distances(designs[i], leaders[:n], angle) <= tol
-            if same_arm_cost is not None and arm is not None and arm.any():
+            if merge:
                 arm_close = design_distances(designs[i][arm], leaders[:n, arm], angle[arm]) <= tol
                 close |= arm_close & (costs[i] <= (1 + same_arm_cost) * leader_costs[:n])
             near = np.flatnonzero(close)
