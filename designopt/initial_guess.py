@@ -26,13 +26,15 @@ INIT_MODES = ("reach", "ik", "home", "constant")
 SPREADS = ("perturb", "box", "mixed")  # how seeded starts spread their designs (`initial_guess`)
 
 
-def perturbed_design(problem: DesignProblem, rng: np.random.Generator, scale: float) -> np.ndarray:
-    """Design joints: configured values plus uniform noise (scale x 0.5 m for lengths, scale x pi for
-    angles), clipped to their bounds."""
+def perturbed_design(problem: DesignProblem, rng: np.random.Generator, scale: float,
+                     around: np.ndarray | None = None) -> np.ndarray:
+    """Design joints: ``around`` (None: the configured values) plus uniform noise (scale x 0.5 m for lengths,
+    scale x pi for angles), clipped to their bounds."""
     joints = problem.chain.design
     noise = rng.uniform(-1.0, 1.0, len(joints))
     step = np.array([0.5 if j.kind == "length" else np.pi for j in joints]) * scale
-    return within_bounds(problem, np.array([j.value for j in joints]) + noise * step)
+    centre = np.array([j.value for j in joints]) if around is None else np.asarray(around, float)
+    return within_bounds(problem, centre + noise * step)
 
 
 def within_bounds(problem: DesignProblem, q_d: np.ndarray) -> np.ndarray:

@@ -548,6 +548,37 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
         next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_extra_pool=60)))
 
 
+def test_extra_starts_moved_around_their_leaders_design():
+    """``rebranch_extra_perturbation``: a leader's extra starts start from its design plus uniform noise of that
+    scale (x 0.5 m for lengths, x pi rad for angles, within the bounds), each start its own draw, the same for the
+    same (seed, index); the drawn starts keep the design exactly; their walks still reach the first waypoint as
+    `first_configuration` says, to the bit. 0: the extras keep the design too."""
+    problem, coarse, sols, task = _two_leaders()
+    extra = Search(starts=6, rebranch=2, seed=4, init="home", rebranch_extra=2, rebranch_extra_pool=5)
+    moved = replace(extra, rebranch_extra_perturbation=0.05)
+    kept = rebranched_tasks([[(task, s) for s in sols]], extra)
+    after = rebranched_tasks([[(task, s) for s in sols]], moved)
+    joints = coarse.chain.design
+    step = np.array([0.5 if j.kind == "length" else np.pi for j in joints]) * 0.05
+    lower, upper = np.array([j.lower for j in joints]), np.array([j.upper for j in joints])
+    for k, leader in enumerate(sols):
+        mine = after[5 * k:5 * k + 5]
+        q_d = np.asarray(leader.raw.q_d, float)
+        for t in mine[:3]:
+            assert np.array_equal(t.start.guess(coarse).q_d, q_d)
+        designs = [t.start.guess(coarse).q_d for t in mine[3:]]
+        for d, t in zip(designs, mine[3:], strict=True):
+            assert np.all(np.abs(d - q_d) <= step + 1e-12) and np.all((lower <= d) & (d <= upper))
+            assert not np.allclose(d, q_d)
+            assert np.array_equal(t.start.first_configuration(coarse), t.start.guess(coarse).Q[0])
+            again = Rebranched(leader, 4, t.start.index, "home", 0.05)
+            assert np.array_equal(again.design(coarse), d)
+        assert not np.allclose(designs[0], designs[1])
+    for t in kept:
+        assert np.array_equal(t.start.design(coarse), np.asarray(t.start.solution.raw.q_d, float))
+    assert "with the design perturbed by 0.05" in moved.describe() and "perturbed by" not in extra.describe()
+
+
 def test_a_later_round_on_new_joint_branches_starts_from_the_best_of_every_round_before_it():
     """``rebranch_rounds``: the rounds on new joint branches share the first round's count (``starts // (rebranch x
     rounds)`` per leader), each from the best distinct optima of every round before it, numbered in blocks from

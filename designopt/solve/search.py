@@ -50,7 +50,8 @@ class Search:
     a leader's starts taken from that many times as many drawn, spread over the branches where their walks reach
     the path's first waypoint, `starts.spread_branches`; ``rebranch_extra`` > 0: that many starts more per leader,
     spread over the branches its drawn ones miss, out of ``rebranch_extra_pool`` drawn in a block of their own,
-    `extra_start`); the
+    `extra_start`; ``rebranch_extra_perturbation`` > 0: those with the design moved around the leader's by that
+    scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`); the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
     cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
     more waypoints), and the
@@ -103,6 +104,7 @@ class Search:
     rebranch_pool: int = 1
     rebranch_extra: int = 0
     rebranch_extra_pool: int = 40
+    rebranch_extra_perturbation: float = 0.0
     screen_waypoints: int = 40
     screen: int = 12
     screen_per_form: int | None = None
@@ -238,6 +240,8 @@ class Search:
         if self.rebranch_extra:
             times += (f" and {self.rebranch_extra} more spread over the branches those miss (of "
                       f"{self.rebranch_extra_pool} drawn)")
+            if self.rebranch_extra_perturbation:
+                times += f" with the design perturbed by {self.rebranch_extra_perturbation:g}"
         again = (f", the best {self.rebranch} distinct{per_form} restarted {times} on a new joint branch"
                  if self.rebranch else "")
         kkt = self._kkt((self.explore_linear_solver,))

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from designopt.initial_guess import design_named, first_configuration, initial_guess, projected, start_number
+from designopt.initial_guess import (design_named, first_configuration, initial_guess, perturbed_design, projected,
+                                     start_number)
 from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.joints import Role
 from designopt.kinematics.reflections import Reflection
@@ -70,23 +71,33 @@ class Rebranched(Numbered):
     """A coarse optimum started again on a new joint branch: its design joints, and start ``index`` of ``seed``'s
     first configuration drawn over the whole circle (revolute joints in [-pi, pi] rad), walked along the path by
     IK (``init``). A design's best basin is often on a branch its own start never visits (a folded posture, the
-    tool near every joint axis): the design and its branch have to be found together."""
+    tool near every joint axis): the design and its branch have to be found together. With ``perturbation`` > 0
+    the design is moved around the optimum's too (`design`): a restart near it, for the better optima of its form
+    that lie a few centimetres or a fraction of a radian away."""
 
     solution: object  # designopt.solution.Solution
     seed: int
     index: int
     init: str = "ik"
+    perturbation: float = 0.0
+
+    def design(self, problem: DesignProblem) -> np.ndarray:
+        """The start's design joints: the optimum's, plus uniform noise of ``perturbation`` x 0.5 m for lengths and
+        x pi rad for angles (`initial_guess.perturbed_design`, drawn from (seed, index) apart from the first
+        configuration's draw), clipped to their bounds; the optimum's own when ``perturbation`` is 0."""
+        q_d = np.asarray(self.solution.raw.q_d, float)
+        if not self.perturbation:
+            return q_d
+        return perturbed_design(problem, np.random.default_rng([self.seed, self.index, 1]), self.perturbation, q_d)
 
     def guess(self, problem: DesignProblem) -> InitialGuess:
         # with a design given, spread "box" only sets the first joints' range: the whole circle
-        return initial_guess(problem, self.index, self.seed, 0.0, self.init, np.asarray(self.solution.raw.q_d, float),
-                             "box")
+        return initial_guess(problem, self.index, self.seed, 0.0, self.init, self.design(problem), "box")
 
     def first_configuration(self, problem: DesignProblem) -> np.ndarray:
         """Where this start's walk reaches the path's first waypoint (`guess`'s first row, for a fraction of its cost:
         `initial_guess.first_configuration`; a seventh on the main job's 10 waypoints)."""
-        return first_configuration(problem, self.index, self.seed, 0.0, self.init,
-                                   np.asarray(self.solution.raw.q_d, float), "box")
+        return first_configuration(problem, self.index, self.seed, 0.0, self.init, self.design(problem), "box")
 
 
 def spread_branches(configurations: np.ndarray, count: int, angle: np.ndarray, kept: int = 1) -> list[int]:

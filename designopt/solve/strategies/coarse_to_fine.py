@@ -137,7 +137,8 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     waypoint (`starts.spread_branches`; the first drawn always among them), in index order; the others are
     never solved and their numbers stay unused. With ``search.rebranch_extra`` > 0 each leader gets that many
     starts more, spread over the branches its starts miss: taken farthest from them (and from each other) out of
-    ``search.rebranch_extra_pool`` drawn from `Search.extra_start`, after its own starts, in index order."""
+    ``search.rebranch_extra_pool`` drawn from `Search.extra_start`, after its own starts, in index order, their
+    designs moved around the leader's by ``search.rebranch_extra_perturbation`` (`Rebranched.perturbation`)."""
     tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
@@ -156,7 +157,7 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
                 pool, firsts = [pool[j] for j in chosen], firsts[chosen]
             if search.rebranch_extra > 0:
                 begin = search.extra_start(round_, k)
-                extras = [Rebranched(sol, search.seed, j, search.init)
+                extras = [Rebranched(sol, search.seed, j, search.init, search.rebranch_extra_perturbation)
                           for j in range(begin, begin + search.rebranch_extra_pool)]
                 firsts = np.vstack([firsts, [start.first_configuration(first.problem) for start in extras]])
                 taken = spread_branches(firsts, len(pool) + search.rebranch_extra, angle, kept=len(pool))
