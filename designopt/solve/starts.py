@@ -14,8 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from designopt.initial_guess import (design_named, first_configuration, initial_guess, perturbed_design, projected,
-                                     start_number)
+from designopt.initial_guess import (
+    design_named,
+    first_configuration,
+    initial_guess,
+    perturbed_design,
+    projected,
+    start_number,
+)
 from designopt.kinematics.chain import placement_pose
 from designopt.kinematics.joints import Role
 from designopt.kinematics.reflections import Reflection
