@@ -550,8 +550,9 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
 
 def test_extra_starts_moved_around_their_leaders_design():
     """``rebranch_extra_perturbation``: a leader's extra starts start from its design plus uniform noise of that
-    scale (x 0.5 m for lengths, x pi rad for angles, within the bounds), each start its own draw, the same for the
-    same (seed, index); the drawn starts keep the design exactly; their walks still reach the first waypoint as
+    scale (x 0.5 m for lengths, x pi rad for angles, within the bounds), each start its own draw (not the branch's:
+    `initial_guess` draws the first configuration from (seed, index)), the same for the same (seed, index); the drawn
+    starts keep the design exactly; their walks still reach the first waypoint as
     `first_configuration` says, to the bit. 0: the extras keep the design too."""
     problem, coarse, sols, task = _two_leaders()
     extra = Search(starts=6, rebranch=2, seed=4, init="home", rebranch_extra=2, rebranch_extra_pool=5)
@@ -570,6 +571,9 @@ def test_extra_starts_moved_around_their_leaders_design():
         for d, t in zip(designs, mine[3:], strict=True):
             assert np.all(np.abs(d - q_d) <= step + 1e-12) and np.all((lower <= d) & (d <= upper))
             assert not np.allclose(d, q_d)
+            inside = (lower < d) & (d < upper)  # noise not clipped: its draw is not the branch's own draw
+            branch = np.random.default_rng([4, t.start.index]).uniform(-1.0, 1.0, len(joints))
+            assert not np.allclose(((d - q_d) / step)[inside], branch[inside])
             assert np.array_equal(t.start.first_configuration(coarse), t.start.guess(coarse).Q[0])
             again = Rebranched(leader, 4, t.start.index, "home", 0.05)
             assert np.array_equal(again.design(coarse), d)
