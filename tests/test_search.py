@@ -484,7 +484,7 @@ def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
     """``rebranch_pool``: each leader's starts drawn that many times over, in a block of start numbers of its own
     (`Search.round_start` counts the pool), the ones taken spread over the branches their walks reach first
     (`spread_branches` of the first configurations), the first drawn always among them; 1: the starts as before.
-    Numbers that would reach the reflect step's are refused."""
+    The reflect step numbers its starts after all of them."""
     problem, coarse, sols, task = _two_leaders()
     plain = Search(starts=6, rebranch=2, seed=4, init="home")
     pooled = replace(plain, rebranch_pool=3)
@@ -503,8 +503,7 @@ def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
         assert taken == sorted(taken[0] + k for k in spread_branches(firsts, 3, angle))
     assert all(pooled.second_round(t.seed) for t in after)
     assert "3x as many drawn" in pooled.describe()
-    with pytest.raises(ValueError, match="numbered past 900"):
-        next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_pool=5)))
+    assert reflect.first_start(replace(preset("default"), rebranch_pool=5)) == 1700  # 160 + 5 x 200 + 10 x 50
 
 
 def test_rows_kept_then_the_rest_spread_farthest_from_them():
@@ -523,7 +522,7 @@ def test_rows_kept_then_the_rest_spread_farthest_from_them():
 def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_they_miss():
     """``rebranch_extra``: each leader's drawn starts stay (the same numbers), and that many more join them, taken
     from ``rebranch_extra_pool`` drawn in a block after every round's (`Search.extra_start`) by `spread_branches`
-    kept at the drawn ones' first configurations. Numbers that would reach the reflect step's are refused."""
+    kept at the drawn ones' first configurations. The reflect step numbers its starts after all of them."""
     problem, coarse, sols, task = _two_leaders()
     plain = Search(starts=6, rebranch=2, seed=4, init="home")
     extra = replace(plain, rebranch_extra=2, rebranch_extra_pool=5)
@@ -543,9 +542,45 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
     assert all(extra.second_round(t.seed) for t in after)
     assert "and 2 more spread over the branches those miss (of 5 drawn)" in extra.describe()
     assert "more spread" not in plain.describe()
-    next(coarse_to_fine.plan([Job("", problem)], preset("default")))  # 360 + 10 x 50 <= 900
-    with pytest.raises(ValueError, match="numbered past 900"):
-        next(coarse_to_fine.plan([Job("", problem)], replace(preset("default"), rebranch_extra_pool=60)))
+    assert preset("default").last_exploration_start == 860 and reflect.first_start(preset("default")) == 900
+    assert reflect.first_start(replace(preset("default"), rebranch_extra_pool=60)) == 1000  # 360 + 10 x 60 = 960
+
+
+def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
+    """``rebranch_moved``: each leader's drawn and extra starts stay as they are (the same numbers and designs), and
+    that many more join them, drawn in a block after the extras' (`Search.moved_start`), their designs moved around
+    the leader's by ``rebranch_moved_perturbation`` (within x 0.5 m / x pi rad of it), taken by `spread_branches`
+    with every start before them kept. The reflect step's numbers follow theirs."""
+    problem, coarse, sols, task = _two_leaders()
+    extra = Search(starts=6, rebranch=2, seed=4, init="home", rebranch_extra=2, rebranch_extra_pool=5)
+    moved = replace(extra, rebranch_moved=2, rebranch_moved_pool=4, rebranch_moved_perturbation=0.05)
+    before = rebranched_tasks([[(task, s) for s in sols]], extra)
+    after = rebranched_tasks([[(task, s) for s in sols]], moved)
+    assert [moved.moved_start(0, k) for k in (0, 1)] == [22, 26] and moved.last_exploration_start == 30
+    assert [t.start.solution for t in after] == [sols[0]] * 7 + [sols[1]] * 7
+    joints = coarse.chain.design
+    step = np.array([0.5 if j.kind == "length" else np.pi for j in joints]) * 0.05
+    angle = np.array([j.kind == "angle" for j in coarse.chain.moving])
+    for k, leader in enumerate(sols):
+        mine, kept = after[7 * k:7 * k + 7], before[5 * k:5 * k + 5]
+        assert [t.start.index for t in mine[:5]] == [t.start.index for t in kept]
+        for t, u in zip(mine[:5], kept, strict=True):
+            assert np.array_equal(t.start.design(coarse), u.start.design(coarse))
+        block = [Rebranched(leader, 4, j, "home", 0.05) for j in range(moved.moved_start(0, k),
+                                                                        moved.moved_start(0, k) + 4)]
+        firsts = np.array([t.start.first_configuration(coarse) for t in kept] +
+                          [s.first_configuration(coarse) for s in block])
+        chosen = spread_branches(firsts, 7, angle, kept=5)[5:]
+        assert [t.start.index for t in mine[5:]] == sorted(moved.moved_start(0, k) + j - 5 for j in chosen)
+        q_d = np.asarray(leader.raw.q_d, float)
+        for t in mine[5:]:
+            d = t.start.design(coarse)
+            assert np.all(np.abs(d - q_d) <= step + 1e-12) and not np.allclose(d, q_d)
+    assert all(moved.second_round(t.seed) for t in after)
+    assert reflect.first_start(moved) == 900
+    assert reflect.first_start(replace(preset("default"), rebranch_moved=10)) == 1100  # 860 + 10 x 20 = 1060
+    assert "and 2 more with the design moved by 0.05" in moved.describe()
+    assert "moved by" not in extra.describe()
 
 
 def test_extra_starts_moved_around_their_leaders_design():

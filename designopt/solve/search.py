@@ -51,7 +51,10 @@ class Search:
     the path's first waypoint, `starts.spread_branches`; ``rebranch_extra`` > 0: that many starts more per leader,
     spread over the branches its drawn ones miss, out of ``rebranch_extra_pool`` drawn in a block of their own,
     `extra_start`; ``rebranch_extra_perturbation`` > 0: those with the design moved around the leader's by that
-    scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`); the
+    scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`; ``rebranch_moved`` > 0: that many starts
+    more again per leader, their designs moved around the leader's by ``rebranch_moved_perturbation``, spread over
+    the branches all the leader's other starts miss, out of ``rebranch_moved_pool`` drawn in a block of their own,
+    `moved_start`); the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
     cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
     more waypoints), and the
@@ -105,6 +108,9 @@ class Search:
     rebranch_extra: int = 0
     rebranch_extra_pool: int = 40
     rebranch_extra_perturbation: float = 0.0
+    rebranch_moved: int = 0
+    rebranch_moved_pool: int = 20
+    rebranch_moved_perturbation: float = 0.1
     screen_waypoints: int = 40
     screen: int = 12
     screen_per_form: int | None = None
@@ -162,12 +168,20 @@ class Search:
         and round, so that the leaders' drawn starts keep the numbers they have without extras."""
         return self.round_start(self.rebranch_rounds) + (r * self.leaders + rank) * self.rebranch_extra_pool
 
+    def moved_start(self, r: int, rank: int) -> int:
+        """The first start index of the ``rebranch_moved_pool`` drawn for the moved starts of round ``r``'s leader
+        of ``rank`` (`rebranch_moved`): after the extras' blocks (`extra_start`), one block of that size per leader
+        and round, so that every other start keeps the number it has without them."""
+        return self.extra_start(self.rebranch_rounds, 0) + (r * self.leaders + rank) * self.rebranch_moved_pool
+
     @property
     def last_exploration_start(self) -> int:
         """One past the largest start index the exploration can use: the rounds' blocks and, with
-        ``rebranch_extra``, the extras' (`extra_start`)."""
+        ``rebranch_extra``, the extras' (`extra_start`), with ``rebranch_moved`` the moved starts' (`moved_start`)."""
         if not self.rebranch:
             return self.most_starts
+        if self.rebranch_moved:
+            return self.moved_start(self.rebranch_rounds, 0)
         if self.rebranch_extra:
             return self.extra_start(self.rebranch_rounds, 0)
         return self.round_start(self.rebranch_rounds)
@@ -242,6 +256,9 @@ class Search:
                       f"{self.rebranch_extra_pool} drawn)")
             if self.rebranch_extra_perturbation:
                 times += f" with the design perturbed by {self.rebranch_extra_perturbation:g}"
+        if self.rebranch_moved:
+            times += (f" and {self.rebranch_moved} more with the design moved by {self.rebranch_moved_perturbation:g}"
+                      f", spread over the branches all those miss (of {self.rebranch_moved_pool} drawn)")
         again = (f", the best {self.rebranch} distinct{per_form} restarted {times} on a new joint branch"
                  if self.rebranch else "")
         kkt = self._kkt((self.explore_linear_solver,))

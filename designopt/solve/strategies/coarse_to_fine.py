@@ -39,7 +39,6 @@ from designopt.problem import DesignProblem
 from designopt.solve.optima import best_solution, distinct_best
 from designopt.solve.search import Searched, by_job
 from designopt.solve.starts import Lifted, Rebranched, spread_branches
-from designopt.solve.strategies.reflect import FIRST_START
 from designopt.solve.strategies.steps import numbered_stage, seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
@@ -138,7 +137,10 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     never solved and their numbers stay unused. With ``search.rebranch_extra`` > 0 each leader gets that many
     starts more, spread over the branches its starts miss: taken farthest from them (and from each other) out of
     ``search.rebranch_extra_pool`` drawn from `Search.extra_start`, after its own starts, in index order, their
-    designs moved around the leader's by ``search.rebranch_extra_perturbation`` (`Rebranched.perturbation`)."""
+    designs moved around the leader's by ``search.rebranch_extra_perturbation`` (`Rebranched.perturbation`). With
+    ``search.rebranch_moved`` > 0 that many more again, their designs moved by ``search.rebranch_moved_perturbation``,
+    spread likewise over the branches every start before them misses, out of ``search.rebranch_moved_pool`` drawn
+    from `Search.moved_start`."""
     tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
@@ -150,7 +152,7 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
             drawn = range(index, index + n * search.rebranch_pool)
             pool = [Rebranched(sol, search.seed, j, search.init) for j in drawn]
             angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
-            if search.rebranch_pool > 1 or search.rebranch_extra > 0:
+            if search.rebranch_pool > 1 or search.rebranch_extra > 0 or search.rebranch_moved > 0:
                 firsts = np.array([start.first_configuration(first.problem) for start in pool])
             if search.rebranch_pool > 1:
                 chosen = sorted(spread_branches(firsts, n, angle))
@@ -159,18 +161,26 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
                 begin = search.extra_start(round_, k)
                 extras = [Rebranched(sol, search.seed, j, search.init, search.rebranch_extra_perturbation)
                           for j in range(begin, begin + search.rebranch_extra_pool)]
-                firsts = np.vstack([firsts, [start.first_configuration(first.problem) for start in extras]])
-                taken = spread_branches(firsts, len(pool) + search.rebranch_extra, angle, kept=len(pool))
-                pool = pool + [extras[j - len(pool)] for j in sorted(taken[len(pool):])]
+                pool, firsts = _spread_more(pool, firsts, extras, search.rebranch_extra, angle, first.problem)
+            if search.rebranch_moved > 0:
+                begin = search.moved_start(round_, k)
+                moved = [Rebranched(sol, search.seed, j, search.init, search.rebranch_moved_perturbation)
+                         for j in range(begin, begin + search.rebranch_moved_pool)]
+                pool, firsts = _spread_more(pool, firsts, moved, search.rebranch_moved, angle, first.problem)
             tasks += [replace(first, start=start) for start in pool]
             index += n * search.rebranch_pool
     return tasks
 
 
+def _spread_more(pool, firsts, more, count: int, angle, problem) -> tuple[list, np.ndarray]:
+    """``pool`` (its walks' first configurations ``firsts``) and ``count`` of the starts ``more`` spread over the
+    branches it misses (`spread_branches`, ``pool`` kept), in index order; and the first configurations of all."""
+    firsts = np.vstack([firsts, [start.first_configuration(problem) for start in more]])
+    taken = sorted(spread_branches(firsts, len(pool) + count, angle, kept=len(pool))[len(pool):])
+    return pool + [more[j - len(pool)] for j in taken], firsts[list(range(len(pool))) + taken]
+
+
 def plan(jobs, search):
-    if search.rebranch and search.last_exploration_start > FIRST_START:
-        raise ValueError(f"the exploration's starts would be numbered past {FIRST_START}, where the reflect "
-                         f"step's begin: fewer starts, leaders or a smaller rebranch_pool or rebranch_extra_pool")
     explore = []
     for job, starts in zip(jobs, exploration_starts([job.problem for job in jobs], search), strict=True):
         coarse = coarse_problem(job.problem, search.explore_waypoints)

@@ -32,8 +32,15 @@ STAGE = "reflect"
 WITHIN = 1e-4
 MU_INIT = 1e-6
 GAIN = 1e-3
-FIRST_START = 900  # the first start index of a reflect stage's starts, after any exploration's
-LEADER_STRIDE = 100  # the start indices of the j-th optimum a round reflects: from FIRST_START + j * LEADER_STRIDE
+FIRST_START = 900  # the first start index of a reflect stage's starts, unless the exploration's reach it (first_start)
+LEADER_STRIDE = 100  # the start indices of the j-th optimum a round reflects: from first_start + j * LEADER_STRIDE
+
+
+def first_start(search) -> int:
+    """The first start index of a reflect stage's starts: ``FIRST_START``, or the first multiple of
+    ``LEADER_STRIDE`` past every index the exploration can use (`Search.last_exploration_start`) when those reach it,
+    so that every start of a run has its own number."""
+    return max(FIRST_START, -(-search.last_exploration_start // LEADER_STRIDE) * LEADER_STRIDE)
 
 
 def plan(searched: list[Searched], search):
@@ -77,10 +84,10 @@ def reflected_tasks(leaders, stage_name: str, search) -> list[Task]:
     """For every (job, its optima to reflect, cheapest first), a task per length of each optimum within ``WITHIN``
     of its bound of 0 whose reflection keeps the motion within the joints' bounds (`kinematics.reflections.at_bound`),
     starting from the solution reflected and pushed ``search.distinct`` across (`Reflected`), solved warm on the
-    full path from barrier ``MU_INIT``. The j-th optimum's start indices from ``FIRST_START + j * LEADER_STRIDE``
-    on (the best's from ``FIRST_START``)."""
+    full path from barrier ``MU_INIT``. The j-th optimum's start indices from ``first_start(search) + j *
+    LEADER_STRIDE`` on (the best's from `first_start`)."""
     warm = search.profile.warmed().with_options(**{"ipopt.mu_init": MU_INIT})
-    tasks = []
+    tasks, begin = [], first_start(search)
     for job, optima in leaders:
         chain = job.problem.chain
         profile, continuation = solve_setup(job, search, warm)
@@ -89,6 +96,6 @@ def reflected_tasks(leaders, stage_name: str, search) -> list[Task]:
             for k, reflection in enumerate(at_bound(chain, best.raw.q_d, WITHIN)):
                 if reflection.joints(chain, Q) is None:
                     continue
-                start = Reflected(best, reflection, search.distinct, search.seed, FIRST_START + j * LEADER_STRIDE + k)
+                start = Reflected(best, reflection, search.distinct, search.seed, begin + j * LEADER_STRIDE + k)
                 tasks.append(Task(job.case, stage_name, job.problem, job.transcription, profile, start, continuation))
     return tasks
