@@ -69,7 +69,8 @@ def main() -> None:
     parser.add_argument("--starts", type=int, default=48)
     parser.add_argument("--rounds", type=int, default=8)
     parser.add_argument("--waypoints", type=int, default=10, help="0: the full path")
-    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--child", action="store_true",
+                        help="measure this checkout in this process only (what each round runs; e.g. under perf)")
     args = parser.parse_args()
     if args.child:
         measure(args.config, args.waypoints, args.starts)
