@@ -70,7 +70,7 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert PRESETS["default"] == Search(starts=160, screen=24, init="home", explore_linear_solver="ldl",
                                         screen_mu_init=(None, 1e-6), refine_mu_init=(None, 1e-6),
                                         rebranch_new_forms=2, reflect=3, reflect_within=1.05, rebranch_extra=30,
-                                        rebranch_extra_pool=50, same_arm_cost=0.002)
+                                        rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10)
     for name in PRESETS:
         assert search_from_config(parse_config({"search": {"preset": name}})) == PRESETS[name]
     changed = search_from_config(parse_config({"search": {"preset": "paper", "seed": 7, "starts": 3}}))
@@ -503,7 +503,7 @@ def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
         assert taken == sorted(taken[0] + k for k in spread_branches(firsts, 3, angle))
     assert all(pooled.second_round(t.seed) for t in after)
     assert "3x as many drawn" in pooled.describe()
-    assert reflect.first_start(replace(preset("default"), rebranch_pool=5)) == 1700  # 160 + 5 x 200 + 10 x 50
+    assert reflect.first_start(replace(preset("default"), rebranch_pool=5)) == 1900  # 160 + 5 x 200 + 10 x (50 + 20)
 
 
 def test_rows_kept_then_the_rest_spread_farthest_from_them():
@@ -542,8 +542,9 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
     assert all(extra.second_round(t.seed) for t in after)
     assert "and 2 more spread over the branches those miss (of 5 drawn)" in extra.describe()
     assert "more spread" not in plain.describe()
-    assert preset("default").last_exploration_start == 860 and reflect.first_start(preset("default")) == 900
-    assert reflect.first_start(replace(preset("default"), rebranch_extra_pool=60)) == 1000  # 360 + 10 x 60 = 960
+    unmoved = replace(preset("default"), rebranch_moved=0)
+    assert unmoved.last_exploration_start == 860 and reflect.first_start(unmoved) == 900
+    assert reflect.first_start(replace(unmoved, rebranch_extra_pool=60)) == 1000  # 360 + 10 x 60 = 960
 
 
 def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
@@ -578,7 +579,7 @@ def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
             assert np.all(np.abs(d - q_d) <= step + 1e-12) and not np.allclose(d, q_d)
     assert all(moved.second_round(t.seed) for t in after)
     assert reflect.first_start(moved) == 900
-    assert reflect.first_start(replace(preset("default"), rebranch_moved=10)) == 1100  # 860 + 10 x 20 = 1060
+    assert reflect.first_start(preset("default")) == 1100  # 860 + 10 x 20 = 1060
     assert "and 2 more with the design moved by 0.05" in moved.describe()
     assert "moved by" not in extra.describe()
 

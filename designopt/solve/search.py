@@ -391,10 +391,13 @@ PRESETS: dict[str, Search] = {
     # (docs/benchmarks.md, "Thirty more starts per leader"). The same arm placed elsewhere at a cost within 0.2 % one
     # optimum (`same_arm_cost`): on seeds never run before (circle and physical stiffness 1584-1593, main job
     # 1717-1726) seeds better / worse 0 / 0, 0 / 0, 1 / 0 at 1.001x, 0.997x, 1.003x the solve time (docs/benchmarks.md,
-    # "The same arm placed elsewhere")
+    # "The same arm placed elsewhere"). Ten more starts per leader with its design moved by 0.1 (`rebranch_moved`):
+    # on seeds never run before (circle and physical stiffness 1604-1613, main job 1737-1746) seeds better / worse
+    # 1 / 0, 1 / 0, 0 / 0 at 1.117x, 1.110x, 1.112x the solve time (docs/benchmarks.md, "Moved starts beside a leader's
+    # exact ones")
     "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
                       refine_mu_init=(None, 1e-6), rebranch_new_forms=2, reflect=3, reflect_within=1.05,
-                      rebranch_extra=30, rebranch_extra_pool=50, same_arm_cost=0.002),
+                      rebranch_extra=30, rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
