@@ -521,24 +521,25 @@ def test_rows_kept_then_the_rest_spread_farthest_from_them():
 
 def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_they_miss():
     """``rebranch_extra``: each leader's drawn starts stay (the same numbers), and that many more join them, taken
-    from ``rebranch_extra_pool`` drawn in a block after every round's (`Search.extra_start`) by `spread_branches`
+    from ``rebranch_extra_pool`` drawn in a block after every round's (`Search.more_start`) by `spread_branches`
     kept at the drawn ones' first configurations. The reflect step numbers its starts after all of them."""
     problem, coarse, sols, task = _two_leaders()
     plain = Search(starts=6, rebranch=2, seed=4, init="home")
     extra = replace(plain, rebranch_extra=2, rebranch_extra_pool=5)
     before = rebranched_tasks([[(task, s) for s in sols]], plain)
     after = rebranched_tasks([[(task, s) for s in sols]], extra)
-    assert extra.extra_start(0, 0) == 12 and extra.extra_start(0, 1) == 17 and extra.last_exploration_start == 22
+    assert extra.more_start(0, 0, 0) == 12 and extra.more_start(0, 0, 1) == 17 and extra.last_exploration_start == 22
     assert [t.start.solution for t in after] == [sols[0]] * 5 + [sols[1]] * 5
     indices = [t.start.index for t in after]
     assert indices[:3] == [t.start.index for t in before[:3]] and indices[5:8] == [t.start.index for t in before[3:]]
     angle = np.array([j.kind == "angle" for j in coarse.chain.moving])
     for k, (leader, mine) in enumerate(((sols[0], indices[:5]), (sols[1], indices[5:]))):
         drawn = [Rebranched(leader, 4, j, "home") for j in mine[:3]]
-        pool = [Rebranched(leader, 4, j, "home") for j in range(extra.extra_start(0, k), extra.extra_start(0, k) + 5)]
+        begin = extra.more_start(0, 0, k)
+        pool = [Rebranched(leader, 4, j, "home") for j in range(begin, begin + 5)]
         firsts = np.array([s.first_configuration(coarse) for s in drawn + pool])
         chosen = spread_branches(firsts, 5, angle, kept=3)[3:]
-        assert mine[3:] == sorted(extra.extra_start(0, k) + j - 3 for j in chosen)
+        assert mine[3:] == sorted(extra.more_start(0, 0, k) + j - 3 for j in chosen)
     assert all(extra.second_round(t.seed) for t in after)
     assert "and 2 more spread over the branches those miss (of 5 drawn)" in extra.describe()
     assert "more spread" not in plain.describe()
@@ -549,7 +550,7 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
 
 def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
     """``rebranch_moved``: each leader's drawn and extra starts stay as they are (the same numbers and designs), and
-    that many more join them, drawn in a block after the extras' (`Search.moved_start`), their designs moved around
+    that many more join them, drawn in a block after the extras' (`Search.more_start`), their designs moved around
     the leader's by ``rebranch_moved_perturbation`` (within x 0.5 m / x pi rad of it), taken by `spread_branches`
     with every start before them kept. The reflect step's numbers follow theirs."""
     problem, coarse, sols, task = _two_leaders()
@@ -557,7 +558,7 @@ def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
     moved = replace(extra, rebranch_moved=2, rebranch_moved_pool=4, rebranch_moved_perturbation=0.05)
     before = rebranched_tasks([[(task, s) for s in sols]], extra)
     after = rebranched_tasks([[(task, s) for s in sols]], moved)
-    assert [moved.moved_start(0, k) for k in (0, 1)] == [22, 26] and moved.last_exploration_start == 30
+    assert [moved.more_start(1, 0, k) for k in (0, 1)] == [22, 26] and moved.last_exploration_start == 30
     assert [t.start.solution for t in after] == [sols[0]] * 7 + [sols[1]] * 7
     joints = coarse.chain.design
     step = np.array([0.5 if j.kind == "length" else np.pi for j in joints]) * 0.05
@@ -567,12 +568,12 @@ def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
         assert [t.start.index for t in mine[:5]] == [t.start.index for t in kept]
         for t, u in zip(mine[:5], kept, strict=True):
             assert np.array_equal(t.start.design(coarse), u.start.design(coarse))
-        block = [Rebranched(leader, 4, j, "home", 0.05) for j in range(moved.moved_start(0, k),
-                                                                        moved.moved_start(0, k) + 4)]
+        block = [Rebranched(leader, 4, j, "home", 0.05) for j in range(moved.more_start(1, 0, k),
+                                                                        moved.more_start(1, 0, k) + 4)]
         firsts = np.array([t.start.first_configuration(coarse) for t in kept] +
                           [s.first_configuration(coarse) for s in block])
         chosen = spread_branches(firsts, 7, angle, kept=5)[5:]
-        assert [t.start.index for t in mine[5:]] == sorted(moved.moved_start(0, k) + j - 5 for j in chosen)
+        assert [t.start.index for t in mine[5:]] == sorted(moved.more_start(1, 0, k) + j - 5 for j in chosen)
         q_d = np.asarray(leader.raw.q_d, float)
         for t in mine[5:]:
             d = t.start.design(coarse)

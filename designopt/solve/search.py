@@ -50,11 +50,11 @@ class Search:
     a leader's starts taken from that many times as many drawn, spread over the branches where their walks reach
     the path's first waypoint, `starts.spread_branches`; ``rebranch_extra`` > 0: that many starts more per leader,
     spread over the branches its drawn ones miss, out of ``rebranch_extra_pool`` drawn in a block of their own,
-    `extra_start`; ``rebranch_extra_perturbation`` > 0: those with the design moved around the leader's by that
+    `more_start`; ``rebranch_extra_perturbation`` > 0: those with the design moved around the leader's by that
     scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`; ``rebranch_moved`` > 0: that many starts
     more again per leader, their designs moved around the leader's by ``rebranch_moved_perturbation``, spread over
     the branches all the leader's other starts miss, out of ``rebranch_moved_pool`` drawn in a block of their own,
-    `moved_start`); the
+    `more_start`; both are `more_blocks`); the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
     cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
     more waypoints), and the
@@ -162,29 +162,32 @@ class Search:
         from a pool ``rebranch_pool`` times as large)."""
         return self.most_starts + r * self.rebranch_pool * sum(self.leader_starts(k) for k in range(self.leaders))
 
-    def extra_start(self, r: int, rank: int) -> int:
-        """The first start index of the ``rebranch_extra_pool`` drawn for the extra starts of round ``r``'s leader
-        of ``rank`` (`rebranch_extra`): after every round's block (`round_start`), one block of that size per leader
-        and round, so that the leaders' drawn starts keep the numbers they have without extras."""
-        return self.round_start(self.rebranch_rounds) + (r * self.leaders + rank) * self.rebranch_extra_pool
+    @property
+    def more_blocks(self) -> tuple[tuple[int, int, float], ...]:
+        """The blocks of starts more per leader of a round on new joint branches, beside its drawn ones, in the
+        order they join them and are numbered (`more_start`): (how many, out of how many drawn, the scale the
+        design is moved by: `starts.Rebranched`) for the extras (``rebranch_extra``), then the moved starts
+        (``rebranch_moved``)."""
+        return ((self.rebranch_extra, self.rebranch_extra_pool, self.rebranch_extra_perturbation),
+                (self.rebranch_moved, self.rebranch_moved_pool, self.rebranch_moved_perturbation))
 
-    def moved_start(self, r: int, rank: int) -> int:
-        """The first start index of the ``rebranch_moved_pool`` drawn for the moved starts of round ``r``'s leader
-        of ``rank`` (`rebranch_moved`): after the extras' blocks (`extra_start`), one block of that size per leader
-        and round, so that every other start keeps the number it has without them."""
-        return self.extra_start(self.rebranch_rounds, 0) + (r * self.leaders + rank) * self.rebranch_moved_pool
+    def more_start(self, block: int, r: int, rank: int) -> int:
+        """The first start index of the pool drawn for block ``block`` of `more_blocks` for round ``r``'s leader
+        of ``rank``: after every round's block (`round_start`) and every earlier block's pools, one pool per
+        leader and round, so that every start keeps the number it has without the blocks after it."""
+        begin = self.round_start(self.rebranch_rounds)
+        for _, size, _ in self.more_blocks[:block]:
+            begin += self.rebranch_rounds * self.leaders * size
+        return begin + (r * self.leaders + rank) * self.more_blocks[block][1]
 
     @property
     def last_exploration_start(self) -> int:
-        """One past the largest start index the exploration can use: the rounds' blocks and, with
-        ``rebranch_extra``, the extras' (`extra_start`), with ``rebranch_moved`` the moved starts' (`moved_start`)."""
+        """One past the largest start index the exploration can use: the rounds' blocks and the pools of the last
+        of `more_blocks` that adds any start."""
         if not self.rebranch:
             return self.most_starts
-        if self.rebranch_moved:
-            return self.moved_start(self.rebranch_rounds, 0)
-        if self.rebranch_extra:
-            return self.extra_start(self.rebranch_rounds, 0)
-        return self.round_start(self.rebranch_rounds)
+        used = [b for b, (count, _, _) in enumerate(self.more_blocks) if count]
+        return self.more_start(used[-1], self.rebranch_rounds, 0) if used else self.round_start(self.rebranch_rounds)
 
     def second_round(self, number):
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,

@@ -136,11 +136,11 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     waypoint (`starts.spread_branches`; the first drawn always among them), in index order; the others are
     never solved and their numbers stay unused. With ``search.rebranch_extra`` > 0 each leader gets that many
     starts more, spread over the branches its starts miss: taken farthest from them (and from each other) out of
-    ``search.rebranch_extra_pool`` drawn from `Search.extra_start`, after its own starts, in index order, their
+    ``search.rebranch_extra_pool`` drawn from `Search.more_start`, after its own starts, in index order, their
     designs moved around the leader's by ``search.rebranch_extra_perturbation`` (`Rebranched.perturbation`). With
     ``search.rebranch_moved`` > 0 that many more again, their designs moved by ``search.rebranch_moved_perturbation``,
     spread likewise over the branches every start before them misses, out of ``search.rebranch_moved_pool`` drawn
-    from `Search.moved_start`."""
+    from `Search.more_start` (one loop over `Search.more_blocks`)."""
     tasks = []
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
@@ -152,21 +152,17 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
             drawn = range(index, index + n * search.rebranch_pool)
             pool = [Rebranched(sol, search.seed, j, search.init) for j in drawn]
             angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
-            if search.rebranch_pool > 1 or search.rebranch_extra > 0 or search.rebranch_moved > 0:
+            if search.rebranch_pool > 1 or any(count > 0 for count, _, _ in search.more_blocks):
                 firsts = np.array([start.first_configuration(first.problem) for start in pool])
             if search.rebranch_pool > 1:
                 chosen = sorted(spread_branches(firsts, n, angle))
                 pool, firsts = [pool[j] for j in chosen], firsts[chosen]
-            if search.rebranch_extra > 0:
-                begin = search.extra_start(round_, k)
-                extras = [Rebranched(sol, search.seed, j, search.init, search.rebranch_extra_perturbation)
-                          for j in range(begin, begin + search.rebranch_extra_pool)]
-                pool, firsts = _spread_more(pool, firsts, extras, search.rebranch_extra, angle, first.problem)
-            if search.rebranch_moved > 0:
-                begin = search.moved_start(round_, k)
-                moved = [Rebranched(sol, search.seed, j, search.init, search.rebranch_moved_perturbation)
-                         for j in range(begin, begin + search.rebranch_moved_pool)]
-                pool, firsts = _spread_more(pool, firsts, moved, search.rebranch_moved, angle, first.problem)
+            for block, (count, size, perturbation) in enumerate(search.more_blocks):
+                if count > 0:
+                    begin = search.more_start(block, round_, k)
+                    more = [Rebranched(sol, search.seed, j, search.init, perturbation)
+                            for j in range(begin, begin + size)]
+                    pool, firsts = _spread_more(pool, firsts, more, count, angle, first.problem)
             tasks += [replace(first, start=start) for start in pool]
             index += n * search.rebranch_pool
     return tasks
