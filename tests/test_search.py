@@ -36,6 +36,7 @@ from designopt.solve import (
     PRESETS,
     Job,
     Search,
+    Searched,
     Seeded,
     SolverProfile,
     Task,
@@ -49,7 +50,7 @@ from designopt.solve import (
 )
 from designopt.solve.optima import arm_joints, cluster_designs, design_forms, form_joints
 from designopt.solve.starts import Rebranched, spread_branches
-from designopt.solve.strategies import coarse_to_fine, reflect
+from designopt.solve.strategies import coarse_to_fine, hop, reflect
 from designopt.solve.strategies.coarse_to_fine import (
     coarse_problem,
     exploration_starts,
@@ -801,10 +802,10 @@ def test_the_screen_takes_at_most_screen_per_form_of_one_form():
     assert "at most 2 of one form" in replace(base, screen_per_form=2).describe()
 
 
-def test_the_search_finds_the_optimum_a_single_start_misses(milling_12):
-    """The PUMA-560 placed by its yaw alone: the optimum over yaw is known by an exhaustive grid (24 yaws, the
-    workpiece fixed, 2 starts each); start 0 (the configured yaw) ends in a local optimum 28 % above it, the
-    search (8 coarse starts, the best 2 refined) reaches it."""
+@pytest.fixture(scope="module")
+def yaw_placed(milling_12):
+    """(problem, known, single): the PUMA-560 placed by its yaw alone, the optimum over yaw by an exhaustive grid (24
+    yaws, the workpiece fixed, 2 starts each), and start 0's solution (from the configured yaw)."""
     def config(design, **placement):
         c = copy.deepcopy(milling_12)
         c["design"] = design
@@ -815,10 +816,14 @@ def test_the_search_finds_the_optimum_a_single_start_misses(milling_12):
     for yaw in np.linspace(-np.pi, np.pi, 25)[:-1]:
         p = problem_from_config(config([], ypr=[float(yaw), 0.0, 0.0]))
         grid += [x.metrics.design_cost for x in (solve(p, index=i, max_iter=300) for i in range(2)) if x.metrics.tracks]
-    known = min(grid)
-
     problem = problem_from_config(config(["yaw"]))
-    single = solve(problem, max_iter=300)
+    return problem, min(grid), solve(problem, max_iter=300)
+
+
+def test_the_search_finds_the_optimum_a_single_start_misses(yaw_placed):
+    """The PUMA-560 placed by its yaw alone: start 0 (the configured yaw) ends in a local optimum 28 % above the
+    grid's optimum, the search (8 coarse starts, the best 2 refined) reaches it."""
+    problem, known, single = yaw_placed
     assert single.metrics.design_cost > 1.2 * known  # one start misses it
 
     search = Search(starts=8, explore_waypoints=6, refine=2, profile=SolverProfile(max_iter=300))
@@ -828,6 +833,59 @@ def test_the_search_finds_the_optimum_a_single_start_misses(milling_12):
     assert best.metrics.design_cost <= known * 1.001  # at least as good as the grid's best
     # 8 seeded starts, then each of the (up to 8) best distinct optima once more on a new joint branch
     assert 8 < len(searched.explore) <= 16 and 1 <= len(searched.final) <= 2
+
+
+def test_the_hop_step_restarts_around_the_answer_and_reaches_the_optimum_it_missed(yaw_placed):
+    """``hop``: when every stage before it ends in start 0's local optimum (28 % above the grid's), the hop step
+    restarts around it ``hop`` times with the yaw moved by up to ``hop_perturbation`` x pi (numbered from
+    `Search.hop_start`), on the screen's waypoints, refines the best ``hop_refine`` distinct on the full path, and
+    the answer is the grid's optimum. The reflect step's numbers follow the hops'."""
+    problem, known, single = yaw_placed
+    assert single.metrics.design_cost > 1.2 * known
+
+    def execute(tasks):  # the strategy's stages end where start 0 did; the hop step solves
+        return [(task, run_task(task) if task.stage.startswith("hop") else single) for task in tasks]
+
+    stages = []
+    search = Search(starts=2, explore_waypoints=6, rebranch=0, screen_waypoints=8, refine=1, hop=4,
+                    hop_incumbents=1, hop_perturbation=0.5, hop_refine=2, profile=SolverProfile(max_iter=300))
+    (searched,) = run_search([Job("", problem)], search, lambda tasks: stages.append(tasks) or execute(tasks))
+    assert [{task.stage for task in tasks} for tasks in stages] == [{"explore"}, {"screen"}, {"refine"}, {"hop"},
+                                                                    {"hop_refine"}]
+    hops, refines = stages[3], stages[4]
+    assert [task.start.index for task in hops] == [2, 3, 4, 5] and search.hop_start(0) == 2
+    assert all(task.problem.toolpath.n == 8 and task.start.solution is single for task in hops)
+    yaws = np.array([task.start.design(task.problem)[0] for task in hops])
+    assert np.all(np.abs(yaws - single.raw.q_d[0]) <= 0.5 * np.pi) and len(set(yaws)) == 4
+    assert len(refines) == 2 and all(task.problem is problem for task in refines)
+    best_task, best = searched.best
+    assert best_task.stage == "hop_refine" and best.metrics.design_cost <= known * 1.001
+    assert [task.stage for task, _ in searched.final] == ["refine", "hop_refine", "hop_refine"]
+    assert "then 4 restarts around each of the best 1 distinct optima" in search.describe()
+    assert "restarts around" not in replace(search, hop=0).describe()
+    default = replace(preset("default"), hop=30)  # the exploration's numbers end at 1060; 1060 + 2 x 30 = 1120
+    assert default.hop_start(1) == 1090 and default.last_start == 1120 and reflect.first_start(default) == 1200
+    assert reflect.first_start(replace(default, hop=0)) == 1100
+
+
+def test_the_hops_start_around_the_best_distinct_tracking_optima_by_rank():
+    """`hop.hop_tasks`: the ``hop_incumbents`` best distinct full-path optima that track (a cheaper one that does not
+    track, and a second solve of the best's optimum, are not incumbents), ``hop`` starts around each, the best's
+    numbered first (`Search.hop_start`), each a `Rebranched` of its incumbent with ``hop_perturbation``."""
+    problem, _, _, _ = _two_leaders()
+    best, again = _optimum(problem, 1.0, (0, 0, 1, 0, 1), 0.0), _optimum(problem, 1.001, (0, 0, 1, 0, 1), 0.001)
+    second, third = _optimum(problem, 2.0, (0, 0, 1, 0, 0), 0.0), _optimum(problem, 3.0, (0, 1, 1, 0, 0), 0.0)
+    lost = _optimum(problem, 0.5, (1, 0, 1, 0, 0), 0.0)
+    lost.metrics.tracks = False
+    task = Task("", "refine", problem, Collocation(), SolverProfile(), Seeded(0, 0))
+    searched = Searched(Job("", problem), [], [(task, sol) for sol in (third, lost, second, again, best)])
+    search = Search(starts=6, rebranch=0, seed=4, hop=3, hop_incumbents=2, hop_perturbation=0.05)
+    tasks = hop.hop_tasks(searched, 5, search)
+    assert [t.start.solution for t in tasks] == [best] * 3 + [second] * 3
+    assert [t.start.index for t in tasks] == [6, 7, 8, 9, 10, 11] and search.last_start == 12
+    assert all(t.stage == "hop" and t.problem.toolpath.n == 5 and t.start.perturbation == 0.05 for t in tasks)
+    assert all(t.start.seed == 4 for t in tasks)
+    assert hop.hop_tasks(searched, None, search)[0].problem is problem  # screened on the full path: hops there
 
 
 def test_a_rebranched_start_keeps_the_design_on_a_new_branch(milling_12):

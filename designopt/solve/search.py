@@ -78,8 +78,12 @@ class Search:
     ``refine``, ``refine2``, ...; the answer is the best of all): from a small one a refine stays in the basin its
     screened start is in, from the warm start's it sometimes walks into a better one and more often into a worse
     one. ``screen_mu_init``: the same for the screen (stages
-    ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``reflect``: after the
-    strategy and the neighbour step, up to this many rounds (stages ``reflect``, ``reflect2``, ...) in which each
+    ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``hop``: after the
+    strategy and the neighbour step, that many restarts around each of the ``hop_incumbents`` best distinct
+    full-path optima, on a new joint branch with the design moved by ``hop_perturbation`` (as
+    ``rebranch_extra_perturbation``), solved on the screen's waypoints (stage ``hop``), the ``hop_refine`` best
+    distinct of them refined on the full path (stage ``hop_refine``; `strategies.hop`); 0: none. ``reflect``: after
+    the hop step, up to this many rounds (stages ``reflect``, ``reflect2``, ...) in which each
     problem's best full-path solution is reflected across the length bounds it lies at (the same arm with that
     length's sign flipped) and solved warm (`strategies.reflect`); 0: none. ``reflect_within``: the first round
     reflects every distinct full-path optimum whose design cost is within this factor of the problem's best, not
@@ -129,6 +133,10 @@ class Search:
     refine_mu_init: tuple[float | None, ...] = (None,)
     reflect: int = 0
     reflect_within: float | None = None
+    hop: int = 0
+    hop_incumbents: int = 2
+    hop_perturbation: float = 0.1
+    hop_refine: int = 6
     small_problem_starts: float = 1.0
 
     @property
@@ -179,6 +187,16 @@ class Search:
         for _, size, _ in self.more_blocks[:block]:
             begin += self.rebranch_rounds * self.leaders * size
         return begin + (r * self.leaders + rank) * self.more_blocks[block][1]
+
+    def hop_start(self, rank: int) -> int:
+        """The first start index of the hops around the full-path optimum of ``rank`` (`strategies.hop`): after
+        every index the exploration can use (`last_exploration_start`), ``hop`` per optimum."""
+        return self.last_exploration_start + rank * self.hop
+
+    @property
+    def last_start(self) -> int:
+        """One past the largest start index the exploration and the hop step can use (`hop_start`)."""
+        return self.hop_start(self.hop_incumbents if self.hop else 0)
 
     @property
     def last_exploration_start(self) -> int:
@@ -232,6 +250,10 @@ class Search:
                  f"every distinct optimum within {self.reflect_within:g}x of the best (later rounds the best)")
         reflect = (f", then {which} reflected across its length bounds (up to {self.reflect} rounds)" if self.reflect
                    else "")
+        if self.hop:
+            reflect = (f", then {self.hop} restarts around each of the best {self.hop_incumbents} distinct optima with "
+                       f"the design moved by {self.hop_perturbation:g}, on the screen's waypoints, the best "
+                       f"{self.hop_refine} of them refined{reflect}")
         if self.strategy == "multistart":
             stall = f"; a TO start no closer to the path for {StalledViolation.PATIENCE} iterations is stopped"
             return (f"multistart: {self.starts} seeded starts{drawn} on the full path ({cap}){stall}{reflect}{held}"

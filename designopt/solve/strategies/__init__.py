@@ -2,9 +2,10 @@
 
 A strategy module has ``plan(jobs, search)``, a generator that yields one stage's tasks for every job, receives
 their (task, solution) pairs, and at the end returns one `Searched` per job. Adding a strategy is a module here
-and a line in `STRATEGIES`. Three steps serve every strategy: `continuation` (finishing a solve stalled on a
-degenerate design), then, after the strategy, `neighbours` (starts from a neighbouring structure's better design)
-and `reflect` (each best, or each optimum near it, reflected across the length bounds it lies at).
+and a line in `STRATEGIES`. Four steps serve every strategy: `continuation` (finishing a solve stalled on a
+degenerate design), then, after the strategy, `neighbours` (starts from a neighbouring structure's better design),
+`hop` (restarts around the best full-path optima) and `reflect` (each best, or each optimum near it, reflected
+across the length bounds it lies at).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from collections.abc import Callable
 
 from designopt.solution import Solution
 from designopt.solve.search import Job, Search, Searched
-from designopt.solve.strategies import coarse_to_fine, multistart, neighbours, reflect
+from designopt.solve.strategies import coarse_to_fine, hop, multistart, neighbours, reflect
 from designopt.solve.tasks import Task
 
 STRATEGIES = {"multistart": multistart, "coarse_to_fine": coarse_to_fine}
@@ -32,6 +33,8 @@ def run_search(jobs: list[Job], search: Search, execute: Execute) -> list[Search
     searched = _drive(STRATEGIES[search.strategy].plan(jobs, search), execute)
     if search.structure_neighbours:
         searched = _drive(neighbours.plan(searched, search), execute)
+    if search.hop:
+        searched = _drive(hop.plan(searched, search), execute)
     if search.reflect:
         searched = _drive(reflect.plan(searched, search), execute)
     return searched

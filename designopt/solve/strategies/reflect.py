@@ -38,9 +38,9 @@ LEADER_STRIDE = 100  # the start indices of the j-th optimum a round reflects: f
 
 def first_start(search) -> int:
     """The first start index of a reflect stage's starts: ``FIRST_START``, or the first multiple of
-    ``LEADER_STRIDE`` past every index the exploration can use (`Search.last_exploration_start`) when those reach it,
-    so that every start of a run has its own number."""
-    return max(FIRST_START, -(-search.last_exploration_start // LEADER_STRIDE) * LEADER_STRIDE)
+    ``LEADER_STRIDE`` past every index the exploration and the hop step can use (`Search.last_start`) when those
+    reach it, so that every start of a run has its own number."""
+    return max(FIRST_START, -(-search.last_start // LEADER_STRIDE) * LEADER_STRIDE)
 
 
 def plan(searched: list[Searched], search):
