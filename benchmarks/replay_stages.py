@@ -40,9 +40,9 @@ ORDER = ("explore", "rebranch", "screen", "refine", "hop", "reflect")
 
 def later(stage: str, number: int, start: str, search) -> bool:
     """Whether a solve of ``stage`` with start ``number`` is of ``start`` or after it (screen2 after screen, refine2
-    after refine, hop_refine after hop; an exploration start of the search's second round, `Search.second_round`,
+    after refine, hop_full after hop; an exploration start of the search's second round, `Search.second_round`,
     is ``rebranch``'s)."""
-    kind = stage_kind(stage).removesuffix("_refine")  # hop_refine is the hop step's
+    kind = stage_kind(stage).removesuffix("_full")  # hop_full is the hop step's
     if kind == "explore" and search.second_round(number):
         kind = "rebranch"
     return kind in ORDER and ORDER.index(kind) >= ORDER.index(start)

@@ -851,7 +851,7 @@ def test_the_hop_step_restarts_around_the_answer_and_reaches_the_optimum_it_miss
                     hop_incumbents=1, hop_perturbation=0.5, hop_refine=2, profile=SolverProfile(max_iter=300))
     (searched,) = run_search([Job("", problem)], search, lambda tasks: stages.append(tasks) or execute(tasks))
     assert [{task.stage for task in tasks} for tasks in stages] == [{"explore"}, {"screen"}, {"refine"}, {"hop"},
-                                                                    {"hop_refine"}]
+                                                                    {"hop_full"}]
     hops, refines = stages[3], stages[4]
     assert [task.start.index for task in hops] == [2, 3, 4, 5] and search.hop_start(0) == 2
     assert all(task.problem.toolpath.n == 8 and task.start.solution is single for task in hops)
@@ -859,9 +859,15 @@ def test_the_hop_step_restarts_around_the_answer_and_reaches_the_optimum_it_miss
     assert np.all(np.abs(yaws - single.raw.q_d[0]) <= 0.5 * np.pi) and len(set(yaws)) == 4
     assert len(refines) == 2 and all(task.problem is problem for task in refines)
     best_task, best = searched.best
-    assert best_task.stage == "hop_refine" and best.metrics.design_cost <= known * 1.001
-    assert [task.stage for task, _ in searched.final] == ["refine", "hop_refine", "hop_refine"]
+    assert best_task.stage == "hop_full" and best.metrics.design_cost <= known * 1.001
+    assert [task.stage for task, _ in searched.final] == ["refine", "hop_full", "hop_full"]
     assert "then 4 restarts around each of the best 1 distinct optima" in search.describe()
+    stages.clear()  # a path of no more waypoints than the screen's: no screen, the hops on the full path, final
+    (searched,) = run_search([Job("", problem)], replace(search, screen_waypoints=12),
+                             lambda tasks: stages.append(tasks) or execute(tasks))
+    assert [{task.stage for task in tasks} for tasks in stages] == [{"explore"}, {"refine"}, {"hop_full"}]
+    assert all(task.problem is problem for task in stages[2]) and searched.best[0].stage == "hop_full"
+    assert [task.stage for task, _ in searched.final] == ["refine"] + ["hop_full"] * 4
     assert "restarts around" not in replace(search, hop=0).describe()
     default = replace(preset("default"), hop=30)  # the exploration's numbers end at 1060; 1060 + 2 x 30 = 1120
     assert default.hop_start(1) == 1090 and default.last_start == 1120 and reflect.first_start(default) == 1200

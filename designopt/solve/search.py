@@ -82,7 +82,7 @@ class Search:
     strategy and the neighbour step, that many restarts around each of the ``hop_incumbents`` best distinct
     full-path optima, on a new joint branch with the design moved by ``hop_perturbation`` (as
     ``rebranch_extra_perturbation``), solved on the screen's waypoints (stage ``hop``), the ``hop_refine`` best
-    distinct of them refined on the full path (stage ``hop_refine``; `strategies.hop`); 0: none. ``reflect``: after
+    distinct of them refined on the full path (stage ``hop_full``; `strategies.hop`); 0: none. ``reflect``: after
     the hop step, up to this many rounds (stages ``reflect``, ``reflect2``, ...) in which each
     problem's best full-path solution is reflected across the length bounds it lies at (the same arm with that
     length's sign flipped) and solved warm (`strategies.reflect`); 0: none. ``reflect_within``: the first round
