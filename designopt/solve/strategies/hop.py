@@ -29,7 +29,7 @@ def plan(searched: list[Searched], search):
     """The hop step over every problem (a generator, as a strategy's plan: yields a stage's tasks, receives their
     solutions); returns ``searched`` with the full-path solves it adds joined to each problem's final solves."""
     jobs = [s.job for s in searched]
-    sizes = [w if w is not None and 0 < w < job.problem.toolpath.n else None  # the path's own count: the full path
+    sizes = [w if w is not None and 0 < w < job.problem.toolpath.n else None  # None: hops on the full path
              for job, (_, w) in zip(jobs, screening([job.problem for job in jobs], search), strict=True)]
     tasks = [task for s, waypoints in zip(searched, sizes, strict=True) for task in hop_tasks(s, waypoints, search)]
     hops = by_job(jobs, (yield tasks))
