@@ -389,7 +389,8 @@ def test_the_second_rounds_leaders_are_capped_per_form():
 def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
     """``new_forms``: after the ``count`` leaders (unchanged, in order), the cheapest optimum of each form not among
     them, cheapest first, at most that many; none when the leaders hold every form. The second round
-    (`Search.rebranch_new_forms`) starts them after the leaders' starts, which stay what they were."""
+    (`Search.rebranch_new_forms`) starts them after the leaders' starts, which stay what they were: their drawn,
+    extra and moved starts the same numbers and designs (`Search.leader_start`)."""
     problem = problem_from_config(parse_config({}))
     a, b, c = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0), (1, 0, 1, 0, 1)
     sols = [_optimum(problem, cost, form, shift) for cost, form, shift in
@@ -409,6 +410,14 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
     assert [t.start.solution for t in after[len(before)::added.rebranch_starts]] == [sols[2], sols[5]]
     assert [t.start.number for t in after] == list(range(4, 4 + 4 * added.rebranch_starts))
     assert "up to 2 forms not among them" in added.describe()
+    more = replace(plain, init="home", rebranch_extra=1, rebranch_extra_pool=3, rebranch_moved=1, rebranch_moved_pool=2)
+    before = rebranched_tasks([[(task, s) for s in sols]], more)
+    after = rebranched_tasks([[(task, s) for s in sols]], replace(more, rebranch_new_forms=2))
+    assert len(before) == 2 * 4 and len(after) == 4 * 4
+    for t, u in zip(after, before, strict=False):
+        assert t.start.number == u.start.number and t.start.solution is u.start.solution
+        assert np.array_equal(t.start.design(problem), u.start.design(problem))
+    assert min(t.start.number for t in after[len(before):]) == 4 + 2 * (2 + 3 + 2)
     # a start's number tells the rounds apart, as the benchmarks read them back from a run's files
     added = replace(added, seed=7)
     seeded = seeded_tasks(Job("", problem), "explore", problem, SolverProfile(), added, added.starts)
@@ -421,8 +430,9 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
 
 def test_the_second_rounds_leaders_get_their_starts_by_rank():
     """``rebranch_shares``: the second round's leader of rank k starts the k-th entry's number of times, a leader past
-    the entries (a new form's) ``rebranch_starts``; the start numbers run on from ``most_starts`` without a gap, all of
-    the second round. Without shares every leader starts ``rebranch_starts`` times."""
+    the entries (a new form's) ``rebranch_starts``; the start numbers run on from ``most_starts``, each leader's in a
+    block as wide as the most any leader has (`Search.leader_width`), all of the second round. Without shares every
+    leader starts ``rebranch_starts`` times."""
     problem = problem_from_config(parse_config({}))
     a, b, c = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0), (1, 0, 1, 0, 1)
     sols = [_optimum(problem, cost, form, shift) for cost, form, shift in
@@ -432,7 +442,7 @@ def test_the_second_rounds_leaders_get_their_starts_by_rank():
     tasks = rebranched_tasks([[(task, s) for s in sols]], shared)
     assert shared.rebranch_starts == 2 and [shared.leader_starts(k) for k in range(3)] == [3, 1, 2]
     assert [t.start.solution for t in tasks] == [sols[0]] * 3 + [sols[1]] + [sols[2]] * 2
-    assert [t.start.index for t in tasks] == list(range(4, 10))
+    assert shared.leader_width == 3 and [t.start.index for t in tasks] == [4, 5, 6, 7, 10, 11]
     assert all(shared.second_round(t.seed) for t in tasks)
     assert "restarted 3, 1 times by rank" in shared.describe()
     even = rebranched_tasks([[(task, s) for s in sols]], replace(shared, rebranch_shares=None))
@@ -483,8 +493,9 @@ def _two_leaders():
 
 def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
     """``rebranch_pool``: each leader's starts drawn that many times over, in a block of start numbers of its own
-    (`Search.round_start` counts the pool), the ones taken spread over the branches their walks reach first
-    (`spread_branches` of the first configurations), the first drawn always among them; 1: the starts as before.
+    (`Search.leader_start`: `leader_width` counts the pool), the ones taken spread over the branches their walks
+    reach first (`spread_branches` of the first configurations), the first drawn always among them; 1: the starts as
+    before.
     The reflect step numbers its starts after all of them."""
     problem, coarse, sols, task = _two_leaders()
     plain = Search(starts=6, rebranch=2, seed=4, init="home")
@@ -492,7 +503,7 @@ def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
     before = rebranched_tasks([[(task, s) for s in sols]], plain)
     assert [t.start.index for t in before] == list(range(6, 12))
     after = rebranched_tasks([[(task, s) for s in sols]], pooled)
-    assert pooled.round_start(0) == 6 and pooled.round_start(1) == 6 + 3 * 6
+    assert [pooled.leader_start(0, k) for k in range(3)] == [6, 6 + 3 * 3, 6 + 2 * 3 * 3]
     assert [t.start.solution for t in after] == [sols[0]] * 3 + [sols[1]] * 3
     first, second = [t.start.index for t in after[:3]], [t.start.index for t in after[3:]]
     assert first[0] == 6 and second[0] == 15 and first == sorted(first) and second == sorted(second)
@@ -504,7 +515,7 @@ def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
         assert taken == sorted(taken[0] + k for k in spread_branches(firsts, 3, angle))
     assert all(pooled.second_round(t.seed) for t in after)
     assert "3x as many drawn" in pooled.describe()
-    assert reflect.first_start(replace(preset("default"), rebranch_pool=5)) == 1900  # 160 + 5 x 200 + 10 x (50 + 20)
+    assert reflect.first_start(replace(preset("default"), rebranch_pool=5)) == 1900  # 160 + 10 x (5 x 20 + 50 + 20)
 
 
 def test_rows_kept_then_the_rest_spread_farthest_from_them():
@@ -521,18 +532,20 @@ def test_rows_kept_then_the_rest_spread_farthest_from_them():
 
 
 def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_they_miss():
-    """``rebranch_extra``: each leader's drawn starts stay (the same numbers), and that many more join them, taken
-    from ``rebranch_extra_pool`` drawn in a block after every round's (`Search.more_start`) by `spread_branches`
-    kept at the drawn ones' first configurations. The reflect step numbers its starts after all of them."""
+    """``rebranch_extra``: each leader's drawn starts stay (the first leader's the same numbers; a later leader's
+    block after the earlier ones' larger blocks), and that many more join them, taken from ``rebranch_extra_pool``
+    drawn in the leader's block after its drawn ones (`Search.more_start`) by `spread_branches` kept at the drawn
+    ones' first configurations. The reflect step numbers its starts after all of them."""
     problem, coarse, sols, task = _two_leaders()
     plain = Search(starts=6, rebranch=2, seed=4, init="home")
     extra = replace(plain, rebranch_extra=2, rebranch_extra_pool=5)
     before = rebranched_tasks([[(task, s) for s in sols]], plain)
     after = rebranched_tasks([[(task, s) for s in sols]], extra)
-    assert extra.more_start(0, 0, 0) == 12 and extra.more_start(0, 0, 1) == 17 and extra.last_exploration_start == 22
+    assert extra.leader_width == 3 + 5 and [extra.leader_start(0, k) for k in (0, 1)] == [6, 14]
+    assert extra.more_start(0, 0, 0) == 9 and extra.more_start(0, 0, 1) == 17 and extra.last_exploration_start == 22
     assert [t.start.solution for t in after] == [sols[0]] * 5 + [sols[1]] * 5
     indices = [t.start.index for t in after]
-    assert indices[:3] == [t.start.index for t in before[:3]] and indices[5:8] == [t.start.index for t in before[3:]]
+    assert indices[:3] == [t.start.index for t in before[:3]] and indices[5:8] == [14, 15, 16]
     angle = np.array([j.kind == "angle" for j in coarse.chain.moving])
     for k, (leader, mine) in enumerate(((sols[0], indices[:5]), (sols[1], indices[5:]))):
         drawn = [Rebranched(leader, 4, j, "home") for j in mine[:3]]
@@ -545,13 +558,14 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
     assert "and 2 more spread over the branches those miss (of 5 drawn)" in extra.describe()
     assert "more spread" not in plain.describe()
     unmoved = replace(preset("default"), rebranch_moved=0)
-    assert unmoved.last_exploration_start == 860 and reflect.first_start(unmoved) == 900
-    assert reflect.first_start(replace(unmoved, rebranch_extra_pool=60)) == 1000  # 360 + 10 x 60 = 960
+    assert unmoved.last_exploration_start == 860 and reflect.first_start(unmoved) == 900  # 160 + 10 x (20 + 50)
+    assert reflect.first_start(replace(unmoved, rebranch_extra_pool=60)) == 1000  # 160 + 10 x (20 + 60) = 960
 
 
 def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
-    """``rebranch_moved``: each leader's drawn and extra starts stay as they are (the same numbers and designs), and
-    that many more join them, drawn in a block after the extras' (`Search.more_start`), their designs moved around
+    """``rebranch_moved``: each leader's drawn and extra starts stay as they are (the leader's design; the first
+    leader's the same numbers, a later leader's block after the earlier ones' larger blocks), and that many more
+    join them, drawn in the leader's block after the extras' pool (`Search.more_start`), their designs moved around
     the leader's by ``rebranch_moved_perturbation`` (within x 0.5 m / x pi rad of it), taken by `spread_branches`
     with every start before them kept. The reflect step's numbers follow theirs."""
     problem, coarse, sols, task = _two_leaders()
@@ -559,16 +573,17 @@ def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
     moved = replace(extra, rebranch_moved=2, rebranch_moved_pool=4, rebranch_moved_perturbation=0.05)
     before = rebranched_tasks([[(task, s) for s in sols]], extra)
     after = rebranched_tasks([[(task, s) for s in sols]], moved)
-    assert [moved.more_start(1, 0, k) for k in (0, 1)] == [22, 26] and moved.last_exploration_start == 30
+    assert [moved.more_start(1, 0, k) for k in (0, 1)] == [14, 26] and moved.last_exploration_start == 30
     assert [t.start.solution for t in after] == [sols[0]] * 7 + [sols[1]] * 7
     joints = coarse.chain.design
     step = np.array([0.5 if j.kind == "length" else np.pi for j in joints]) * 0.05
     angle = np.array([j.kind == "angle" for j in coarse.chain.moving])
+    assert [t.start.index for t in after[:5]] == [t.start.index for t in before[:5]]
+    assert [t.start.index for t in after[7:10]] == [18, 19, 20]  # the second leader's block: 6 + (3 + 5 + 4)
     for k, leader in enumerate(sols):
-        mine, kept = after[7 * k:7 * k + 7], before[5 * k:5 * k + 5]
-        assert [t.start.index for t in mine[:5]] == [t.start.index for t in kept]
-        for t, u in zip(mine[:5], kept, strict=True):
-            assert np.array_equal(t.start.design(coarse), u.start.design(coarse))
+        mine, kept = after[7 * k:7 * k + 7], after[7 * k:7 * k + 5]
+        for t in kept:
+            assert np.array_equal(t.start.design(coarse), np.asarray(leader.raw.q_d, float))
         block = [Rebranched(leader, 4, j, "home", 0.05) for j in range(moved.more_start(1, 0, k),
                                                                         moved.more_start(1, 0, k) + 4)]
         firsts = np.array([t.start.first_configuration(coarse) for t in kept] +
@@ -581,7 +596,7 @@ def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
             assert np.all(np.abs(d - q_d) <= step + 1e-12) and not np.allclose(d, q_d)
     assert all(moved.second_round(t.seed) for t in after)
     assert reflect.first_start(moved) == 900
-    assert reflect.first_start(preset("default")) == 1100  # 860 + 10 x 20 = 1060
+    assert reflect.first_start(preset("default")) == 1100  # 160 + 10 x (20 + 50 + 20) = 1060
     assert "and 2 more with the design moved by 0.05" in moved.describe()
     assert "moved by" not in extra.describe()
 
@@ -624,23 +639,24 @@ def test_extra_starts_moved_around_their_leaders_design():
 def test_a_later_round_on_new_joint_branches_starts_from_the_best_of_every_round_before_it():
     """``rebranch_rounds``: the rounds on new joint branches share the first round's count (``starts // (rebranch x
     rounds)`` per leader), each from the best distinct optima of every round before it, numbered in blocks from
-    ``most_starts`` (`Search.round_start`), every one of them told apart from the first round. Driven through the
-    plan: the explored solves in, each round's tasks out."""
+    ``most_starts``, a leader's rounds side by side (`Search.leader_start`), every one of them told apart from the
+    first round. Driven through the plan: the explored solves in, each round's tasks out."""
     problem = problem_from_config(parse_config({}))
     a = (0, 0, 1, 0, 1)
     search = Search(starts=4, rebranch=2, rebranch_rounds=2, seed=5)
-    assert search.rebranch_starts == 1 and [search.round_start(r) for r in range(3)] == [4, 6, 8]
+    assert search.rebranch_starts == 1 and search.leader_width == 1  # leader k's round r: 4 + 2 k + r
+    assert [search.leader_start(r, k) for k in range(2) for r in range(2)] == [4, 5, 6, 7]
     assert replace(search, rebranch_rounds=1).rebranch_starts == 2
     plan = coarse_to_fine.plan([Job("", problem)], search)
     explore = next(plan)
     first = [_optimum(problem, cost, a, shift) for cost, shift in ((3.0, 0.0), (1.0, 0.1), (2.0, 0.2), (4.0, 0.3))]
     round1 = plan.send(list(zip(explore, first, strict=True)))
     assert [t.start.solution for t in round1] == [first[1], first[2]]
-    assert [t.start.index for t in round1] == [4, 5]
+    assert [t.start.index for t in round1] == [4, 6]
     found = [_optimum(problem, 0.5, a, 0.4), _optimum(problem, 5.0, a, 0.5)]  # the first leader's start did better
     round2 = plan.send(list(zip(round1, found, strict=True)))
     assert [t.start.solution for t in round2] == [found[0], first[1]]
-    assert [t.start.index for t in round2] == [6, 7]
+    assert [t.start.index for t in round2] == [5, 7]
     assert all(search.second_round(t.seed) for t in round1 + round2)
     assert not any(search.second_round(t.seed) for t in explore)
     assert "in 2 rounds, each from the best of every round before it" in search.describe()

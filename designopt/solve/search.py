@@ -164,12 +164,6 @@ class Search:
         """The most leaders a round on new joint branches has: ``rebranch`` and ``rebranch_new_forms``."""
         return self.rebranch + self.rebranch_new_forms
 
-    def round_start(self, r: int) -> int:
-        """The first start index of round ``r`` on new joint branches (0: the second round of the exploration):
-        ``most_starts``, then one block per round, as large as a round can be (every leader's starts, each drawn
-        from a pool ``rebranch_pool`` times as large)."""
-        return self.most_starts + r * self.rebranch_pool * sum(self.leader_starts(k) for k in range(self.leaders))
-
     @property
     def more_blocks(self) -> tuple[tuple[int, int, float], ...]:
         """The blocks of starts more per leader of a round on new joint branches, beside its drawn ones, in the
@@ -179,14 +173,31 @@ class Search:
         return ((self.rebranch_extra, self.rebranch_extra_pool, self.rebranch_extra_perturbation),
                 (self.rebranch_moved, self.rebranch_moved_pool, self.rebranch_moved_perturbation))
 
+    @property
+    def leader_drawn(self) -> int:
+        """The start indices a leader's drawn starts take in one round on new joint branches: the most starts any
+        leader has (`leader_starts`), drawn ``rebranch_pool`` times over."""
+        return self.rebranch_pool * max([self.rebranch_starts, *(self.rebranch_shares or ())])
+
+    @property
+    def leader_width(self) -> int:
+        """The start indices one leader takes in one round on new joint branches: its drawn starts
+        (`leader_drawn`), then the pool of every block of `more_blocks` that adds any start."""
+        return self.leader_drawn + sum(size for count, size, _ in self.more_blocks if count > 0)
+
+    def leader_start(self, r: int, rank: int) -> int:
+        """The first start index of round ``r``'s leader of ``rank`` (0: the cheapest) on new joint branches, the
+        first of its drawn starts: ``most_starts``, then one block of `leader_width` per leader and round, by rank
+        first, so that a leader's starts keep their numbers whatever the count of leaders after it (e.g. more new
+        forms, ``rebranch_new_forms``)."""
+        return self.most_starts + (rank * self.rebranch_rounds + r) * self.leader_width
+
     def more_start(self, block: int, r: int, rank: int) -> int:
         """The first start index of the pool drawn for block ``block`` of `more_blocks` for round ``r``'s leader
-        of ``rank``: after every round's block (`round_start`) and every earlier block's pools, one pool per
-        leader and round, so that every start keeps the number it has without the blocks after it."""
-        begin = self.round_start(self.rebranch_rounds)
-        for _, size, _ in self.more_blocks[:block]:
-            begin += self.rebranch_rounds * self.leaders * size
-        return begin + (r * self.leaders + rank) * self.more_blocks[block][1]
+        of ``rank``: in that leader's block (`leader_start`), after its drawn starts and the pools of the earlier
+        blocks that add any start."""
+        earlier = sum(size for count, size, _ in self.more_blocks[:block] if count > 0)
+        return self.leader_start(r, rank) + self.leader_drawn + earlier
 
     def hop_start(self, rank: int) -> int:
         """The first start index of the hops around the full-path optimum of ``rank`` (`strategies.hop`): after
@@ -200,12 +211,11 @@ class Search:
 
     @property
     def last_exploration_start(self) -> int:
-        """One past the largest start index the exploration can use: the rounds' blocks and the pools of the last
-        of `more_blocks` that adds any start."""
+        """One past the largest start index the exploration can use: every leader's block in every round on new
+        joint branches (`leader_start`)."""
         if not self.rebranch:
             return self.most_starts
-        used = [b for b, (count, _, _) in enumerate(self.more_blocks) if count]
-        return self.more_start(used[-1], self.rebranch_rounds, 0) if used else self.round_start(self.rebranch_rounds)
+        return self.leader_start(0, self.leaders)
 
     def second_round(self, number):
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,

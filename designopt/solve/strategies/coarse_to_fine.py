@@ -130,10 +130,10 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     cheapest of each of up to ``search.rebranch_new_forms`` forms not among them, each started
     ``search.leader_starts(rank)`` (``starts // rebranch`` unless ``rebranch_shares``) times on a new joint branch,
     as the task that found it (the same coarse problem, profile and continuation); start indices follow the
-    exploration's, one after the other from round ``round_``'s block (`Search.round_start`; round 0 from
-    ``search.most_starts``). With ``search.rebranch_pool`` > 1 a leader's starts are drawn that many times over
-    (the indices of its block) and the ones taken spread over the branches where their walks reach the first
-    waypoint (`starts.spread_branches`; the first drawn always among them), in index order; the others are
+    exploration's, in a block per leader and round (`Search.leader_start`: a leader's starts keep their numbers
+    whatever the count of leaders after it). With ``search.rebranch_pool`` > 1 a leader's starts are drawn that
+    many times over (the indices of its block) and the ones taken spread over the branches where their walks reach
+    the first waypoint (`starts.spread_branches`; the first drawn always among them), in index order; the others are
     never solved and their numbers stay unused. With ``search.rebranch_extra`` > 0 each leader gets that many
     starts more, spread over the branches its starts miss: taken farthest from them (and from each other) out of
     ``search.rebranch_extra_pool`` drawn from `Search.more_start`, after its own starts, in index order, their
@@ -145,10 +145,10 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
     for done in found:
         leaders = distinct_best([sol for _, sol in done], search.rebranch, search.distinct, search.rebranch_per_form,
                                 search.rebranch_new_forms, search.same_arm_cost)
-        index = search.round_start(round_)
         for k, i in enumerate(leaders):
             first, sol = done[i]
             n = search.leader_starts(k)
+            index = search.leader_start(round_, k)
             drawn = range(index, index + n * search.rebranch_pool)
             pool = [Rebranched(sol, search.seed, j, search.init) for j in drawn]
             angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
@@ -164,7 +164,6 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
                             for j in range(begin, begin + size)]
                     pool, firsts = _spread_more(pool, firsts, more, count, angle, first.problem)
             tasks += [replace(first, start=start) for start in pool]
-            index += n * search.rebranch_pool
     return tasks
 
 
