@@ -70,7 +70,7 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert search_from_config(parse_config({})) == PRESETS["default"]
     assert PRESETS["default"] == Search(starts=160, screen=24, init="home", explore_linear_solver="ldl",
                                         screen_mu_init=(None, 1e-6), refine_mu_init=(None, 1e-6),
-                                        rebranch_new_forms=2, reflect=3, reflect_within=1.05, rebranch_extra=30,
+                                        rebranch_new_forms=4, reflect=3, reflect_within=1.05, rebranch_extra=30,
                                         rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10)
     for name in PRESETS:
         assert search_from_config(parse_config({"search": {"preset": name}})) == PRESETS[name]
@@ -515,7 +515,7 @@ def test_a_leaders_starts_taken_from_a_larger_pool_spread_over_branches():
         assert taken == sorted(taken[0] + k for k in spread_branches(firsts, 3, angle))
     assert all(pooled.second_round(t.seed) for t in after)
     assert "3x as many drawn" in pooled.describe()
-    assert reflect.first_start(replace(preset("default"), rebranch_pool=5)) == 1900  # 160 + 10 x (5 x 20 + 50 + 20)
+    assert reflect.first_start(replace(preset("default"), rebranch_pool=5)) == 2200  # 160 + 12 x (5 x 20 + 50 + 20)
 
 
 def test_rows_kept_then_the_rest_spread_farthest_from_them():
@@ -558,8 +558,8 @@ def test_a_leaders_drawn_starts_kept_and_extra_ones_spread_over_the_branches_the
     assert "and 2 more spread over the branches those miss (of 5 drawn)" in extra.describe()
     assert "more spread" not in plain.describe()
     unmoved = replace(preset("default"), rebranch_moved=0)
-    assert unmoved.last_exploration_start == 860 and reflect.first_start(unmoved) == 900  # 160 + 10 x (20 + 50)
-    assert reflect.first_start(replace(unmoved, rebranch_extra_pool=60)) == 1000  # 160 + 10 x (20 + 60) = 960
+    assert unmoved.last_exploration_start == 1000 and reflect.first_start(unmoved) == 1000  # 160 + 12 x (20 + 50)
+    assert reflect.first_start(replace(unmoved, rebranch_extra_pool=60)) == 1200  # 160 + 12 x (20 + 60) = 1120
 
 
 def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
@@ -596,7 +596,7 @@ def test_moved_starts_join_a_leaders_other_starts_on_the_branches_those_miss():
             assert np.all(np.abs(d - q_d) <= step + 1e-12) and not np.allclose(d, q_d)
     assert all(moved.second_round(t.seed) for t in after)
     assert reflect.first_start(moved) == 900
-    assert reflect.first_start(preset("default")) == 1100  # 160 + 10 x (20 + 50 + 20) = 1060
+    assert reflect.first_start(preset("default")) == 1300  # 160 + 12 x (20 + 50 + 20) = 1240
     assert "and 2 more with the design moved by 0.05" in moved.describe()
     assert "moved by" not in extra.describe()
 
@@ -885,9 +885,9 @@ def test_the_hop_step_restarts_around_the_answer_and_reaches_the_optimum_it_miss
     assert all(task.problem is problem for task in stages[2]) and searched.best[0].stage == "hop_full"
     assert [task.stage for task, _ in searched.final] == ["refine"] + ["hop_full"] * 4
     assert "restarts around" not in replace(search, hop=0).describe()
-    default = replace(preset("default"), hop=30)  # the exploration's numbers end at 1060; 1060 + 2 x 30 = 1120
-    assert default.hop_start(1) == 1090 and default.last_start == 1120 and reflect.first_start(default) == 1200
-    assert reflect.first_start(replace(default, hop=0)) == 1100
+    default = replace(preset("default"), hop=40)  # the exploration's numbers end at 1240; 1240 + 2 x 40 = 1320
+    assert default.hop_start(1) == 1280 and default.last_start == 1320 and reflect.first_start(default) == 1400
+    assert reflect.first_start(replace(default, hop=0)) == 1300
 
 
 def test_the_hops_start_around_the_best_distinct_tracking_optima_by_rank():

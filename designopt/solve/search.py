@@ -429,9 +429,12 @@ PRESETS: dict[str, Search] = {
     # "The same arm placed elsewhere"). Ten more starts per leader with its design moved by 0.1 (`rebranch_moved`):
     # on seeds never run before (circle and physical stiffness 1604-1613, main job 1737-1746) seeds better / worse
     # 1 / 0, 1 / 0, 0 / 0 at 1.117x, 1.110x, 1.112x the solve time (docs/benchmarks.md, "Moved starts beside a leader's
-    # exact ones")
+    # exact ones"). The best of up to four forms not among the leaders instead of two (`rebranch_new_forms`), each
+    # leader's starts numbered in a block of its own (`leader_start`): on seeds never run before (circle and physical
+    # stiffness 1624-1633, main job 1767-1776) seeds better / worse 0 / 0, 1 / 0, 0 / 0 at 1.106x, 1.111x, 1.114x the
+    # solve time (docs/benchmarks.md, "Four forms not among the leaders")
     "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
-                      refine_mu_init=(None, 1e-6), rebranch_new_forms=2, reflect=3, reflect_within=1.05,
+                      refine_mu_init=(None, 1e-6), rebranch_new_forms=4, reflect=3, reflect_within=1.05,
                       rebranch_extra=30, rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
