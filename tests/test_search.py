@@ -428,6 +428,48 @@ def test_the_second_round_adds_the_best_of_forms_its_leaders_lack():
         [False] * len(seeded) + [True] * len(rebranched))
 
 
+def test_the_screen_adds_the_best_of_leaders_whose_starts_it_lacks():
+    """``new_lineages``: after the ``count`` distinct optima, the cheapest optimum of each lineage not among them,
+    cheapest first, at most that many; a solution of no lineage (None) never added. `Search.leader_of` tells a
+    second-round start's leader by its number (None for the first round and past the exploration), and the screen
+    (`Search.screen_new_leaders`) adds the best of each leader's starts it lacks. Driven through the plan."""
+    problem = problem_from_config(parse_config({}))
+    a, b = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0)
+    sols = [_optimum(problem, cost, form, shift) for cost, form, shift in
+            ((1.0, a, 0.0), (2.0, a, 0.1), (3.0, b, 0.0), (4.0, a, 0.2), (5.0, b, 0.3), (6.0, a, 0.4))]
+    lineages = [0, None, 0, 1, None, 2]
+    assert distinct_best(sols, 2, lineages=lineages) == [0, 1]
+    assert distinct_best(sols, 1, lineages=lineages, new_lineages=1) == [0, 3]
+    assert distinct_best(sols, 1, lineages=lineages, new_lineages=5) == [0, 3, 5]
+    assert distinct_best(sols, 3, lineages=lineages, new_lineages=5) == [0, 1, 2, 3, 5]
+    twin = _optimum(problem, 0.5, a, 0.001)  # a cheaper solve of optimum 0, of lineage 3, stands for it
+    assert distinct_best(sols + [twin], 1, lineages=lineages + [3], new_lineages=5) == [6, 2, 3, 5]
+
+    search = Search(starts=4, rebranch=2, rebranch_new_forms=1, init="home", rebranch_extra=1, rebranch_extra_pool=3,
+                    seed=2, screen=2, screen_new_leaders=3)
+    assert search.leader_width == 2 + 3 and search.last_exploration_start == 4 + 3 * 5
+    assert [search.leader_of(start_number(2, i)) for i in (0, 3, 4, 8, 9, 18, 19, 100)] == [
+        None, None, 0, 0, 1, 2, None, None]
+    plan = coarse_to_fine.plan([Job("", problem)], search)
+    explore = next(plan)
+    first = [_optimum(problem, cost, form, shift) for cost, form, shift in
+             ((1.0, a, 0.0), (1.5, a, 0.1), (1.8, a, 0.2), (1.9, b, 0.9))]
+    rebranched = plan.send(list(zip(explore, first, strict=True)))
+    assert [t.start.solution for t in rebranched] == [first[0]] * 3 + [first[1]] * 3 + [first[3]] * 3
+    assert [search.leader_of(t.seed) for t in rebranched] == [0] * 3 + [1] * 3 + [2] * 3
+    assert all(search.leader_of(t.seed) is None for t in explore)
+    second = [_optimum(problem, cost, form, shift) for cost, form, shift in
+              ((2.0, b, 0.0), (2.5, b, 0.1), (3.0, a, 0.3), (7.0, a, 0.5), (4.0, b, 0.4), (8.0, b, 0.6),
+               (9.0, a, 0.7), (9.5, a, 0.8), (5.0, b, 0.7))]
+    screen = plan.send(list(zip(rebranched, second, strict=True)))
+    assert {t.stage for t in screen} == {"screen"}
+    # the best 2 distinct (the first round's), then each leader's starts' cheapest (the first round's 1.8 and 1.9
+    # are of no leader's starts)
+    assert [t.start.solution for t in screen] == first[:2] + [second[0], second[4], second[8]]
+    assert "the best of up to 3 second-round leaders' starts not among them" in search.describe()
+    assert "second-round leaders" not in replace(search, screen_new_leaders=0).describe()
+
+
 def test_the_second_rounds_leaders_get_their_starts_by_rank():
     """``rebranch_shares``: the second round's leader of rank k starts the k-th entry's number of times, a leader past
     the entries (a new form's) ``rebranch_starts``; the start numbers run on from ``most_starts``, each leader's in a

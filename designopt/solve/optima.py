@@ -81,14 +81,17 @@ def design_forms(designs: np.ndarray, form: np.ndarray) -> list[tuple[int, ...]]
 
 
 def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int | None = None,
-                  new_forms: int = 0, same_arm_cost: float | None = None) -> list[int]:
+                  new_forms: int = 0, same_arm_cost: float | None = None, lineages: list | None = None,
+                  new_lineages: int = 0) -> list[int]:
     """Indices into ``solutions`` of the best tracking solution of each of the ``count`` cheapest distinct
     optima (`cluster_designs`), cheapest first. ``per_form``: at most this many optima of one form
     (`design_forms`) before the optima of other forms, cheapest first; then, if fewer than ``count`` are taken,
     the cheapest of the rest (None: by cost alone; a design space without form joints has one form, and is
     taken by cost alone too). ``new_forms``: then, beyond the ``count``, the cheapest optimum of each of up to
     this many forms not among them, cheapest first. ``same_arm_cost``: the same arm within that fraction of a
-    cheaper optimum's cost is that optimum (`cluster_designs`; None: designs compared joint by joint only)."""
+    cheaper optimum's cost is that optimum (`cluster_designs`; None: designs compared joint by joint only).
+    ``new_lineages``: then the cheapest optimum of each of up to this many lineages not among them, cheapest first,
+    where ``lineages`` gives each solution's (e.g. the second-round leader whose starts found it; None: of none)."""
     tracking = [i for i, s in enumerate(solutions) if s.metrics.tracks]
     if not tracking or count <= 0:
         return []
@@ -120,6 +123,14 @@ def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int 
                 break
             if f not in seen:
                 seen.add(f)
+                picked.append(k)
+    if new_lineages and lineages is not None:
+        seen, wanted = {lineages[tracking[k]] for k in picked}, len(picked) + new_lineages
+        for k in ranked:
+            if len(picked) == wanted:
+                break
+            if lineages[tracking[k]] is not None and lineages[tracking[k]] not in seen:
+                seen.add(lineages[tracking[k]])
                 picked.append(k)
     return [tracking[k] for k in picked]
 

@@ -57,7 +57,8 @@ class Search:
     `more_start`; both are `more_blocks`); the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
     cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
-    more waypoints), and the
+    more waypoints), with the cheapest distinct optimum of each of up to ``screen_new_leaders`` second-round leaders
+    whose starts have none among them (`leader_of`), and the
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
     design joint are one optimum; with ``same_arm_cost``, so are two whose arms (every design joint but the
     placement's) lie within ``distinct`` and whose design costs within that fraction of the cheaper's: the same arm
@@ -118,6 +119,7 @@ class Search:
     screen_waypoints: int = 40
     screen: int = 12
     screen_per_form: int | None = None
+    screen_new_leaders: int = 0
     screen_max_iter: int = 300
     refine: int = 4
     distinct: float = 0.02
@@ -217,6 +219,14 @@ class Search:
             return self.most_starts
         return self.leader_start(0, self.leaders)
 
+    def leader_of(self, number) -> int | None:
+        """The rank of the second-round leader whose block (`leader_start`) holds the exploration start numbered
+        ``number``; None for a start of the first round or past the exploration's numbers."""
+        index = start_index(number, self.seed)
+        if not self.rebranch or not self.most_starts <= index < self.last_exploration_start:
+            return None
+        return (index - self.most_starts) // (self.rebranch_rounds * self.leader_width)
+
     def second_round(self, number):
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,
         on a new joint branch: its index (`initial_guess.start_index`) from ``most_starts`` on
@@ -269,6 +279,8 @@ class Search:
             return (f"multistart: {self.starts} seeded starts{drawn} on the full path ({cap}){stall}{reflect}{held}"
                     f"{solver}")
         capped = f" (at most {self.screen_per_form} of one form)" if self.screen_per_form is not None else ""
+        if self.screen_new_leaders:
+            capped += f" and the best of up to {self.screen_new_leaders} second-round leaders' starts not among them"
         if self.small_problem_starts > 1:
             capped += " (a smaller problem's more, on more waypoints, in proportion)"
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "

@@ -91,9 +91,11 @@ def _unknowns(problems: list[DesignProblem], waypoints: int) -> list[int]:
 
 
 def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, search, max_iter: int | None = None,
-                 mu_init: float | None = None, per_form: int | None = None, linear_solver: str | None = None):
+                 mu_init: float | None = None, per_form: int | None = None, linear_solver: str | None = None,
+                 new_leaders: int = 0):
     """For every job, its ``count`` best distinct solutions (at most ``per_form`` of one form before other forms,
-    `optima.distinct_best`; None: by cost alone) lifted to ``waypoints`` (None: the full path), each solved warm
+    `optima.distinct_best`; None: by cost alone; then the best of each of up to ``new_leaders`` second-round leaders'
+    starts with none among them, `Search.leader_of`) lifted to ``waypoints`` (None: the full path), each solved warm
     within ``max_iter`` iterations (None: the profile's own cap), from barrier parameter ``mu_init`` (None: the warm
     start's own), its KKT systems by ``linear_solver`` (None: the profile's)."""
     warm = search.profile.warmed().capped(max_iter).solved_by(linear_solver)
@@ -103,8 +105,9 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     for job, done in zip(jobs, found, strict=True):
         problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
         profile, continuation = solve_setup(job, search, warm)
+        lineages = [search.leader_of(task.seed) for task, _ in done] if new_leaders else None
         for i in distinct_best([sol for _, sol in done], count, search.distinct, per_form,
-                               same_arm_cost=search.same_arm_cost):
+                               same_arm_cost=search.same_arm_cost, lineages=lineages, new_lineages=new_leaders):
             tasks.append(Task(job.case, stage, problem, job.transcription, profile, Lifted(done[i][1]), continuation))
     return tasks
 
@@ -195,7 +198,8 @@ def plan(jobs, search):
                  if i < len(search.passes_for(jobs[k].problem.chain.n_moving))
                  for task in lifted_tasks([jobs[k]], [explored[k]], screens[k][0], numbered_stage("screen", i),
                                           screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
-                                          per_form=search.screen_per_form, linear_solver=solver)]
+                                          per_form=search.screen_per_form, linear_solver=solver,
+                                          new_leaders=search.screen_new_leaders)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
