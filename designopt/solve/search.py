@@ -223,7 +223,7 @@ class Search:
         """The rank of the second-round leader whose block (`leader_start`) holds the exploration start numbered
         ``number``; None for a start of the first round or past the exploration's numbers."""
         index = start_index(number, self.seed)
-        if not self.rebranch or not self.most_starts <= index < self.last_exploration_start:
+        if not self.most_starts <= index < self.last_exploration_start:  # empty without leaders
             return None
         return (index - self.most_starts) // (self.rebranch_rounds * self.leader_width)
 
