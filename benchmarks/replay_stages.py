@@ -35,7 +35,7 @@ from designopt.tables import stage_kind
 
 ROOT = Path(__file__).resolve().parent.parent
 # a stage's rows are dropped with every later one (refine2, ... follow); "rebranch" is the exploration's second round
-ORDER = ("explore", "rebranch", "screen", "refine", "hop", "reflect")
+ORDER = ("explore", "rebranch", "prescreen", "screen", "refine", "hop", "reflect")
 
 
 def later(stage: str, number: int, start: str, search) -> bool:

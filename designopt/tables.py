@@ -39,7 +39,8 @@ def best_per_dof(table: pd.DataFrame) -> pd.DataFrame:
     return tracking.groupby("dof").head(1).sort_values("dof")
 
 
-COARSE_STAGES = ("explore", "screen", "hop")  # solves on a coarser sampling of the path; every other stage is full-path
+# solves on a coarser sampling of the path; every other stage is full-path
+COARSE_STAGES = ("explore", "prescreen", "screen", "hop")
 
 
 def stage_kind(stage) -> str:

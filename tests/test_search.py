@@ -860,6 +860,50 @@ def test_the_screen_takes_at_most_screen_per_form_of_one_form():
     assert "at most 2 of one form" in replace(base, screen_per_form=2).describe()
 
 
+def test_the_prescreen_ranks_the_screens_candidates_on_more_waypoints():
+    """`Search.prescreen`: the best ``prescreen`` distinct coarse optima are lifted to ``prescreen_waypoints`` (stage
+    ``prescreen``, solved as the screen's first pass: its cap and barrier), and the screen lifts the best
+    ``screen`` distinct of *their* optima, whatever their coarse order; without it, or when the screen's waypoints
+    are no more than the prescreen's, the screen lifts the best coarse optima. Driven through the plan."""
+    problem = problem_from_config(parse_config({}))
+    a = (0, 0, 1, 0, 1)
+    job = Job("", problem)
+
+    def optima(costs, shifts, seeds):
+        out = [_optimum(problem, cost, a, shift) for cost, shift in zip(costs, shifts, strict=True)]
+        for sol, seed in zip(out, seeds, strict=True):
+            sol.raw.seed = seed
+        return out
+
+    def explored(search):
+        plan = coarse_to_fine.plan([job], search)
+        explore = next(plan)
+        sols = optima([1.0, 2.0, 3.0, 4.0, 5.0, 6.0], [0.0, 0.1, 0.2, 0.3, 0.4, 0.5], [t.seed for t in explore])
+        return plan, sols, plan.send(list(zip(explore, sols, strict=True)))
+
+    search = Search(starts=6, rebranch=0, screen=2, screen_waypoints=20, prescreen=4, prescreen_waypoints=15,
+                    screen_mu_init=(1e-6, None), screen_max_iter=77)
+    assert problem.toolpath.n > search.screen_waypoints
+    plan, sols, pre = explored(search)
+    assert {t.stage for t in pre} == {"prescreen"}
+    assert [t.start.solution for t in pre] == sols[:4]  # the best 4 distinct coarse optima
+    assert {t.problem.toolpath.n for t in pre} == {15}
+    assert {t.profile.max_iter for t in pre} == {77}
+    assert {dict(t.profile.options)["ipopt.mu_init"] for t in pre} == {1e-6}  # the screen's first pass
+    # on 15 waypoints the coarse order turns: the coarse 4th and 3rd are the best two
+    lifted = optima([4.0, 3.0, 1.5, 1.2], [0.0, 0.1, 0.2, 0.3], [t.seed for t in pre])
+    screen = plan.send(list(zip(pre, lifted, strict=True)))
+    assert {t.stage for t in screen} == {"screen", "screen2"}
+    assert [t.start.solution for t in screen if t.stage == "screen"] == [lifted[3], lifted[2]]
+    assert {t.problem.toolpath.n for t in screen} == {20}
+    assert "the best 4 distinct re-ranked first on 15 waypoints" in search.describe()
+
+    for without in (replace(search, prescreen=0), replace(search, prescreen_waypoints=20)):
+        _, sols, screen = explored(without)
+        assert [t.start.solution for t in screen if t.stage == "screen"] == sols[:2]
+    assert "re-ranked first" not in replace(search, prescreen=0).describe()
+
+
 @pytest.fixture(scope="module")
 def yaw_placed(milling_12):
     """(problem, known, single): the PUMA-560 placed by its yaw alone, the optimum over yaw by an exhaustive grid (24

@@ -17,14 +17,18 @@ design optimal for the full path. Stages, each across every problem:
    distinct optima of every round before it; with ``rebranch_pool`` > 1 a leader's starts are drawn that many times
    over and those kept spread over the branches their walks reach first; with ``rebranch_extra`` > 0 (the default's
    30) a leader's drawn starts all stay and that many more join them, spread over the branches they miss.
-2. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
-   optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem of several more,
-   on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within ``screen_max_iter``
-   and ranked again there: the coarse ranking alone often puts a design that lifts badly ahead of one that lifts
-   well. Once per barrier of ``screen_mu_init`` and linear solver of ``screen_linear_solver`` (stages ``screen``,
-   ``screen2``, ...: `Search.screen_passes`; a small arm the first pass only, when
+2. ``prescreen`` (with ``search.prescreen`` > 0, on fewer waypoints than the screen's): the ``prescreen`` best
+   distinct coarse optima lifted to ``prescreen_waypoints`` and solved warm as the screen's first pass solves (a
+   smaller problem's more, as for the screen), their optima then the screen's candidates: a ranking on more
+   waypoints than the exploration's, for more candidates than the screen can afford.
+3. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
+   (or prescreened) optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem
+   of several more, on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within
+   ``screen_max_iter`` and ranked again there: the coarse ranking alone often puts a design that lifts badly ahead
+   of one that lifts well. Once per barrier of ``screen_mu_init`` and linear solver of ``screen_linear_solver``
+   (stages ``screen``, ``screen2``, ...: `Search.screen_passes`; a small arm the first pass only, when
    ``small_arm_screens_once``), each candidate ranked by its better pass.
-3. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
+4. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
    once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
 """
@@ -194,9 +198,21 @@ def plan(jobs, search):
     if screened:
         sub = [jobs[k] for k in screened]
         screens = screening([job.problem for job in jobs], search)
+        pool = {k: explored[k] for k in screened}
+        pre = [k for k in screened if search.prescreen
+               and search.prescreen_waypoints < (screens[k][1] or jobs[k].problem.toolpath.n)]
+        if pre:  # the screen's candidates re-ranked first on fewer waypoints, as its first pass solves
+            first_mu, first_solver = search.screen_passes[0]
+            tasks = [task for k in pre
+                     for task in lifted_tasks([jobs[k]], [explored[k]], round(search.prescreen * screens[k][0]
+                                                                              / search.screen),
+                                              "prescreen", search.prescreen_waypoints, search, search.screen_max_iter,
+                                              mu_init=first_mu, per_form=search.screen_per_form,
+                                              linear_solver=first_solver, new_leaders=search.screen_new_leaders)]
+            pool.update(zip(pre, by_job([jobs[k] for k in pre], (yield tasks)), strict=True))
         tasks = [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
                  if i < len(search.passes_for(jobs[k].problem.chain.n_moving))
-                 for task in lifted_tasks([jobs[k]], [explored[k]], screens[k][0], numbered_stage("screen", i),
+                 for task in lifted_tasks([jobs[k]], [pool[k]], screens[k][0], numbered_stage("screen", i),
                                           screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
                                           per_form=search.screen_per_form, linear_solver=solver,
                                           new_leaders=search.screen_new_leaders)]
