@@ -203,10 +203,10 @@ def plan(jobs, search):
                and search.prescreen_waypoints < (screens[k][1] or jobs[k].problem.toolpath.n)]
         if pre:  # the screen's candidates re-ranked first on fewer waypoints, as its first pass solves
             first_mu, first_solver = search.screen_passes[0]
+            count = {k: round(search.prescreen * screens[k][0] / search.screen) for k in pre}  # as `screening`
             tasks = [task for k in pre
-                     for task in lifted_tasks([jobs[k]], [explored[k]], round(search.prescreen * screens[k][0]
-                                                                              / search.screen),
-                                              "prescreen", search.prescreen_waypoints, search, search.screen_max_iter,
+                     for task in lifted_tasks([jobs[k]], [explored[k]], count[k], "prescreen",
+                                              search.prescreen_waypoints, search, search.screen_max_iter,
                                               mu_init=first_mu, per_form=search.screen_per_form,
                                               linear_solver=first_solver, new_leaders=search.screen_new_leaders)]
             pool.update(zip(pre, by_job([jobs[k] for k in pre], (yield tasks)), strict=True))
