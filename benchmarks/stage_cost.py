@@ -41,15 +41,22 @@ def compared(base: Path, variant: Path, runs: list[str]) -> tuple[pd.DataFrame, 
     """Per stage, the solves and iterations of ``runs`` in ``base`` and ``variant`` and the base's ms per
     iteration; and the variant's solve time estimated at those times per iteration, over the base's. A full-path
     stage the base does not have (a variant's new one, e.g. ``reflect``) is priced at the base's refine (the same
-    problem, solved warm)."""
+    problem, solved warm); a coarse one (e.g. ``prescreen``) at the variant's own time per iteration in it, times
+    the base's over the variant's in the screen (both solved the screen's problems: the machine's load between
+    the two runs taken out)."""
     b, v = (pd.concat([stages(d / r) for r in runs]).groupby(level=0).sum() for d in (base, variant))
     new = [s for s in v.index if s not in b.index]
-    if any(is_coarse(s) for s in new):
-        raise ValueError(f"the base has no stage to price the variant's {new} by")
     index = list(b.index) + new
     b, v = b.reindex(index, fill_value=0), v.reindex(index, fill_value=0)
+    own = v["seconds"] / v["iterations"]
     per_iteration = (b["seconds"] / b["iterations"]).where(~b.index.isin(new), b.at["refine", "seconds"]
                                                            / b.at["refine", "iterations"])
+    coarse = [s for s in new if is_coarse(s)]
+    if coarse:
+        if "screen" not in b.index or not (b.at["screen", "iterations"] and v.at["screen", "iterations"]):
+            raise ValueError(f"both need a screen to price the variant's {coarse} by")
+        load = (b.at["screen", "seconds"] / b.at["screen", "iterations"]) / own["screen"]
+        per_iteration[coarse] = own[coarse] * load
     table = pd.DataFrame({"solves": b["solves"], "variant solves": v["solves"], "iterations": b["iterations"],
                           "variant iterations": v["iterations"], "ms per iteration": 1e3 * per_iteration})
     return table, float((v["iterations"] * per_iteration).sum() / b["seconds"].sum())
