@@ -862,9 +862,10 @@ def test_the_screen_takes_at_most_screen_per_form_of_one_form():
 
 def test_the_prescreen_ranks_the_screens_candidates_on_more_waypoints():
     """`Search.prescreen`: the best ``prescreen`` distinct coarse optima are lifted to ``prescreen_waypoints`` (stage
-    ``prescreen``, solved as the screen's first pass: its cap and barrier), and the screen lifts the best
-    ``screen`` distinct of *their* optima, whatever their coarse order; without it, or when the screen's waypoints
-    are no more than the prescreen's, the screen lifts the best coarse optima. Driven through the plan."""
+    ``prescreen``, solved as the screen's first pass: its cap and barrier), and the screen lifts ``screen`` of
+    those coarse optima taken alternately by coarse cost and by prescreened cost (`alternately_ranked`; one that
+    does not track last); without it, or when the screen's waypoints are no more than the prescreen's, the screen
+    lifts the best coarse optima. Driven through the plan."""
     problem = problem_from_config(parse_config({}))
     a = (0, 0, 1, 0, 1)
     job = Job("", problem)
@@ -881,26 +882,33 @@ def test_the_prescreen_ranks_the_screens_candidates_on_more_waypoints():
         sols = optima([1.0, 2.0, 3.0, 4.0, 5.0, 6.0], [0.0, 0.1, 0.2, 0.3, 0.4, 0.5], [t.seed for t in explore])
         return plan, sols, plan.send(list(zip(explore, sols, strict=True)))
 
-    search = Search(starts=6, rebranch=0, screen=2, screen_waypoints=20, prescreen=4, prescreen_waypoints=15,
+    search = Search(starts=6, rebranch=0, screen=3, screen_waypoints=20, prescreen=5, prescreen_waypoints=15,
                     screen_mu_init=(1e-6, None), screen_max_iter=77)
     assert problem.toolpath.n > search.screen_waypoints
     plan, sols, pre = explored(search)
     assert {t.stage for t in pre} == {"prescreen"}
-    assert [t.start.solution for t in pre] == sols[:4]  # the best 4 distinct coarse optima
+    assert [t.start.solution for t in pre] == sols[:5]  # the best 5 distinct coarse optima
     assert {t.problem.toolpath.n for t in pre} == {15}
     assert {t.profile.max_iter for t in pre} == {77}
     assert {dict(t.profile.options)["ipopt.mu_init"] for t in pre} == {1e-6}  # the screen's first pass
-    # on 15 waypoints the coarse order turns: the coarse 4th and 3rd are the best two
-    lifted = optima([4.0, 3.0, 1.5, 1.2], [0.0, 0.1, 0.2, 0.3], [t.seed for t in pre])
-    screen = plan.send(list(zip(pre, lifted, strict=True)))
+    # on 15 waypoints the coarse order turns: coarse 5th, then 4th, ...; the 3rd does not track
+    lifted = optima([4.0, 3.0, 0.5, 1.2, 1.0], [0.0, 0.1, 0.2, 0.3, 0.4], [t.seed for t in pre])
+    lifted[2].metrics.tracks = False
+    screen = plan.send(list(zip(pre, lifted, strict=True))[::-1])  # the order solves come back in does not matter
     assert {t.stage for t in screen} == {"screen", "screen2"}
-    assert [t.start.solution for t in screen if t.stage == "screen"] == [lifted[3], lifted[2]]
+    # alternately: coarse 1st, prescreened 1st (coarse 5th), coarse 2nd; each lifted from its coarse optimum
+    assert [t.start.solution for t in screen if t.stage == "screen"] == [sols[0], sols[1], sols[4]]
     assert {t.problem.toolpath.n for t in screen} == {20}
-    assert "the best 4 distinct re-ranked first on 15 waypoints" in search.describe()
+    assert "of the best 5 distinct re-ranked first on 15 waypoints" in search.describe()
+    taken = coarse_to_fine.alternately_ranked
+    pairs = [(SimpleNamespace(seed=t.seed, start=t.start), sol) for t, sol in zip(pre, lifted, strict=True)]
+    coarse = [(SimpleNamespace(seed=t.seed), sol) for t, sol in zip(pre, sols[:5], strict=True)]
+    assert [c[1] for c in taken(coarse, pairs, 5)] == [sols[0], sols[4], sols[1], sols[3], sols[2]]
+    assert [c[1] for c in taken(coarse, pairs, 1)] == [sols[0]]
 
     for without in (replace(search, prescreen=0), replace(search, prescreen_waypoints=20)):
         _, sols, screen = explored(without)
-        assert [t.start.solution for t in screen if t.stage == "screen"] == sols[:2]
+        assert [t.start.solution for t in screen if t.stage == "screen"] == sols[:3]
     assert "re-ranked first" not in replace(search, prescreen=0).describe()
 
 

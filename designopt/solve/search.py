@@ -56,8 +56,9 @@ class Search:
     the branches all the leader's other starts miss, out of ``rebranch_moved_pool`` drawn in a block of their own,
     `more_start`; both are `more_blocks`); with ``prescreen`` > 0, that many best distinct of both rounds first
     lifted to ``prescreen_waypoints`` and solved warm as the screen's first pass solves (stage ``prescreen``;
-    skipped when the screen's waypoints are no more), the screen's candidates then the best of those; the
-    ``screen`` best distinct of both rounds (or of the prescreen; at most ``screen_per_form`` of one form before
+    skipped when the screen's waypoints are no more), the screen's candidates then taken from those alternately by
+    coarse cost and by that cost (`strategies.coarse_to_fine.alternately_ranked`); else the
+    ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before
     other forms; None: by cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped
     when the path has no more waypoints), with the cheapest distinct optimum of each of up to
     ``screen_new_leaders`` second-round leaders whose starts have none among them (`leader_of`), and the
@@ -288,8 +289,8 @@ class Search:
         if self.small_problem_starts > 1:
             capped += " (a smaller problem's more, on more waypoints, in proportion)"
         if self.prescreen:
-            capped += (f" of the best {self.prescreen} distinct re-ranked first on {self.prescreen_waypoints} "
-                       "waypoints (as the screen's first pass)")
+            capped += (f", of the best {self.prescreen} distinct re-ranked first on {self.prescreen_waypoints} "
+                       "waypoints (as the screen's first pass) taken alternately by either cost,")
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
                   f"{self._kkt(self.screen_linear_solver)}{self._repeated()}, if the path has more)"

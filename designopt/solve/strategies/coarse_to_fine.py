@@ -19,8 +19,9 @@ design optimal for the full path. Stages, each across every problem:
    30) a leader's drawn starts all stay and that many more join them, spread over the branches they miss.
 2. ``prescreen`` (with ``search.prescreen`` > 0, on fewer waypoints than the screen's): the ``prescreen`` best
    distinct coarse optima lifted to ``prescreen_waypoints`` and solved warm as the screen's first pass solves (a
-   smaller problem's more, as for the screen), their optima then the screen's candidates: a ranking on more
-   waypoints than the exploration's, for more candidates than the screen can afford.
+   smaller problem's more, as for the screen): a second ranking, on more waypoints than the exploration's, of more
+   candidates than the screen can afford; the screen takes them alternately by either ranking
+   (`alternately_ranked`).
 3. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    (or prescreened) optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem
    of several more, on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within
@@ -116,6 +117,23 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     return tasks
 
 
+def alternately_ranked(explored, prescreened, count: int) -> list:
+    """The ``count`` explored (task, solution) pairs the screen lifts after a prescreen: the prescreened candidates'
+    coarse optima (``prescreened``: (task, solution) of each, its task's start the coarse optimum) taken alternately
+    by their coarse cost and by their prescreened cost (one that does not track last), each ranking skipping what
+    the other took. The coarse ranking keeps the candidates the screen would take without a prescreen, the first
+    half of them; the prescreen's brings those the exploration's few waypoints rank low."""
+    by_seed = {task.seed: (task, sol) for task, sol in explored}
+    coarse = sorted(prescreened, key=lambda d: d[0].start.solution.metrics.design_cost)
+    finer = sorted(prescreened, key=lambda d: d[1].metrics.design_cost if d[1].metrics.tracks else np.inf)
+    taken: list[int] = []
+    for a, b in zip(coarse, finer, strict=True):
+        for task, _ in (a, b):
+            if len(taken) < count and task.seed not in taken:
+                taken.append(task.seed)
+    return [by_seed[seed] for seed in taken]
+
+
 def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:
     """One (task, solution) per start of a stage solved in several passes (`numbered_stage`; the same starts): the
     pass whose solution tracks at the lowest design cost (the first pass's when none tracks), in start order. A
@@ -199,23 +217,23 @@ def plan(jobs, search):
         sub = [jobs[k] for k in screened]
         screens = screening([job.problem for job in jobs], search)
         pool = {k: explored[k] for k in screened}
+        choose = {"per_form": search.screen_per_form, "new_leaders": search.screen_new_leaders}
         pre = [k for k in screened if search.prescreen
                and search.prescreen_waypoints < (screens[k][1] or jobs[k].problem.toolpath.n)]
-        if pre:  # the screen's candidates re-ranked first on fewer waypoints, as its first pass solves
+        if pre:  # a second ranking of more candidates, on more waypoints, as the screen's first pass solves
             first_mu, first_solver = search.screen_passes[0]
             count = {k: round(search.prescreen * screens[k][0] / search.screen) for k in pre}  # as `screening`
             tasks = [task for k in pre
                      for task in lifted_tasks([jobs[k]], [explored[k]], count[k], "prescreen",
                                               search.prescreen_waypoints, search, search.screen_max_iter,
-                                              mu_init=first_mu, per_form=search.screen_per_form,
-                                              linear_solver=first_solver, new_leaders=search.screen_new_leaders)]
-            pool.update(zip(pre, by_job([jobs[k] for k in pre], (yield tasks)), strict=True))
+                                              mu_init=first_mu, linear_solver=first_solver, **choose)]
+            for k, done in zip(pre, by_job([jobs[k] for k in pre], (yield tasks)), strict=True):
+                pool[k] = alternately_ranked(explored[k], done, screens[k][0])  # each one screened
         tasks = [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
                  if i < len(search.passes_for(jobs[k].problem.chain.n_moving))
                  for task in lifted_tasks([jobs[k]], [pool[k]], screens[k][0], numbered_stage("screen", i),
                                           screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
-                                          per_form=search.screen_per_form, linear_solver=solver,
-                                          new_leaders=search.screen_new_leaders)]
+                                          linear_solver=solver, **({} if k in pre else choose))]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
