@@ -860,18 +860,18 @@ def test_the_screen_takes_at_most_screen_per_form_of_one_form():
     assert "at most 2 of one form" in replace(base, screen_per_form=2).describe()
 
 
-def test_the_prescreen_ranks_the_screens_candidates_on_more_waypoints():
-    """`Search.prescreen`: the best ``prescreen`` distinct coarse optima are lifted to ``prescreen_waypoints`` (stage
-    ``prescreen``, solved as the screen's first pass: its cap and barrier), and the screen lifts ``screen`` of
-    those coarse optima taken alternately by coarse cost and by prescreened cost (`alternately_ranked`; one that
-    does not track last); without it, or when the screen's waypoints are no more than the prescreen's, the screen
-    lifts the best coarse optima. Driven through the plan."""
+def test_the_prescreen_adds_the_best_of_the_next_coarse_optima_on_more_waypoints():
+    """`Search.prescreen`: the ``prescreen`` best distinct coarse optima after the screen's are lifted to
+    ``prescreen_waypoints`` (stage ``prescreen``, solved as the screen's first pass: its cap and barrier), and the
+    ``prescreen_keep`` of them whose prescreened optima track cheapest join the screen's candidates, each lifted
+    from its coarse optimum (`best_prescreened`); without it, or when the screen's waypoints are no more than the
+    prescreen's, the screen lifts the best coarse optima alone. Driven through the plan."""
     problem = problem_from_config(parse_config({}))
     a = (0, 0, 1, 0, 1)
     job = Job("", problem)
 
-    def optima(costs, shifts, seeds):
-        out = [_optimum(problem, cost, a, shift) for cost, shift in zip(costs, shifts, strict=True)]
+    def optima(costs, seeds):
+        out = [_optimum(problem, cost, a, 0.1 * k) for k, cost in enumerate(costs)]
         for sol, seed in zip(out, seeds, strict=True):
             sol.raw.seed = seed
         return out
@@ -879,37 +879,35 @@ def test_the_prescreen_ranks_the_screens_candidates_on_more_waypoints():
     def explored(search):
         plan = coarse_to_fine.plan([job], search)
         explore = next(plan)
-        sols = optima([1.0, 2.0, 3.0, 4.0, 5.0, 6.0], [0.0, 0.1, 0.2, 0.3, 0.4, 0.5], [t.seed for t in explore])
+        sols = optima([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0], [t.seed for t in explore])
         return plan, sols, plan.send(list(zip(explore, sols, strict=True)))
 
-    search = Search(starts=6, rebranch=0, screen=3, screen_waypoints=20, prescreen=5, prescreen_waypoints=15,
-                    screen_mu_init=(1e-6, None), screen_max_iter=77)
+    search = Search(starts=8, rebranch=0, screen=2, screen_waypoints=20, prescreen=4, prescreen_keep=2,
+                    prescreen_waypoints=15, screen_mu_init=(1e-6, None), screen_max_iter=77)
     assert problem.toolpath.n > search.screen_waypoints
     plan, sols, pre = explored(search)
     assert {t.stage for t in pre} == {"prescreen"}
-    assert [t.start.solution for t in pre] == sols[:5]  # the best 5 distinct coarse optima
+    assert [t.start.solution for t in pre] == sols[2:6]  # the 4 best distinct after the screen's 2
     assert {t.problem.toolpath.n for t in pre} == {15}
     assert {t.profile.max_iter for t in pre} == {77}
     assert {dict(t.profile.options)["ipopt.mu_init"] for t in pre} == {1e-6}  # the screen's first pass
-    # on 15 waypoints the coarse order turns: coarse 5th, then 4th, ...; the 3rd does not track
-    lifted = optima([4.0, 3.0, 0.5, 1.2, 1.0], [0.0, 0.1, 0.2, 0.3, 0.4], [t.seed for t in pre])
-    lifted[2].metrics.tracks = False
+    # on 15 waypoints the coarse 5th and 6th are the cheapest that track (the 4th does not track)
+    lifted = optima([4.0, 0.5, 1.0, 3.0], [t.seed for t in pre])
+    lifted[1].metrics.tracks = False
     screen = plan.send(list(zip(pre, lifted, strict=True))[::-1])  # the order solves come back in does not matter
     assert {t.stage for t in screen} == {"screen", "screen2"}
-    # alternately: coarse 1st, prescreened 1st (coarse 5th), coarse 2nd; each lifted from its coarse optimum
-    assert [t.start.solution for t in screen if t.stage == "screen"] == [sols[0], sols[1], sols[4]]
+    for stage in ("screen", "screen2"):  # each lifted from its coarse optimum
+        assert [t.start.solution for t in screen if t.stage == stage] == [sols[0], sols[1], sols[4], sols[5]]
     assert {t.problem.toolpath.n for t in screen} == {20}
-    assert "of the best 5 distinct re-ranked first on 15 waypoints" in search.describe()
-    taken = coarse_to_fine.alternately_ranked
-    pairs = [(SimpleNamespace(seed=t.seed, start=t.start), sol) for t, sol in zip(pre, lifted, strict=True)]
-    coarse = [(SimpleNamespace(seed=t.seed), sol) for t, sol in zip(pre, sols[:5], strict=True)]
-    assert [c[1] for c in taken(coarse, pairs, 5)] == [sols[0], sols[4], sols[1], sols[3], sols[2]]
-    assert [c[1] for c in taken(coarse, pairs, 1)] == [sols[0]]
+    assert "the best 2 of the next 4 re-ranked on 15 waypoints" in search.describe()
+    pairs = [(SimpleNamespace(seed=t.seed), sol) for t, sol in zip(pre, lifted, strict=True)]
+    coarse = [(SimpleNamespace(seed=t.seed), sol) for t, sol in zip(pre, sols[2:6], strict=True)]
+    assert [c[1] for c in coarse_to_fine.best_prescreened(coarse, pairs, 5)] == [sols[4], sols[5], sols[2]]
 
     for without in (replace(search, prescreen=0), replace(search, prescreen_waypoints=20)):
         _, sols, screen = explored(without)
-        assert [t.start.solution for t in screen if t.stage == "screen"] == sols[:3]
-    assert "re-ranked first" not in replace(search, prescreen=0).describe()
+        assert [t.start.solution for t in screen if t.stage == "screen"] == sols[:2]
+    assert "re-ranked on 15" not in replace(search, prescreen=0).describe()
 
 
 @pytest.fixture(scope="module")

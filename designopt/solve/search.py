@@ -54,14 +54,14 @@ class Search:
     scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`; ``rebranch_moved`` > 0: that many starts
     more again per leader, their designs moved around the leader's by ``rebranch_moved_perturbation``, spread over
     the branches all the leader's other starts miss, out of ``rebranch_moved_pool`` drawn in a block of their own,
-    `more_start`; both are `more_blocks`); with ``prescreen`` > 0, that many best distinct of both rounds first
-    lifted to ``prescreen_waypoints`` and solved warm as the screen's first pass solves (stage ``prescreen``;
-    skipped when the screen's waypoints are no more), the screen's candidates then taken from those alternately by
-    coarse cost and by that cost (`strategies.coarse_to_fine.alternately_ranked`); else the
+    `more_start`; both are `more_blocks`); the
     ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before
     other forms; None: by cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped
     when the path has no more waypoints), with the cheapest distinct optimum of each of up to
-    ``screen_new_leaders`` second-round leaders whose starts have none among them (`leader_of`), and the
+    ``screen_new_leaders`` second-round leaders whose starts have none among them (`leader_of`), and with
+    ``prescreen`` > 0 the ``prescreen_keep`` best of the ``prescreen`` next distinct coarse optima solved warm on
+    ``prescreen_waypoints`` as the screen's first pass solves (stage ``prescreen``; skipped when the screen's
+    waypoints are no more: `strategies.coarse_to_fine.best_prescreened`), and the
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
     design joint are one optimum; with ``same_arm_cost``, so are two whose arms (every design joint but the
     placement's) lie within ``distinct`` and whose design costs within that fraction of the cheaper's: the same arm
@@ -125,6 +125,7 @@ class Search:
     screen_new_leaders: int = 0
     screen_max_iter: int = 300
     prescreen: int = 0
+    prescreen_keep: int = 8
     prescreen_waypoints: int = 20
     refine: int = 4
     distinct: float = 0.02
@@ -289,8 +290,8 @@ class Search:
         if self.small_problem_starts > 1:
             capped += " (a smaller problem's more, on more waypoints, in proportion)"
         if self.prescreen:
-            capped += (f", of the best {self.prescreen} distinct re-ranked first on {self.prescreen_waypoints} "
-                       "waypoints (as the screen's first pass) taken alternately by either cost,")
+            capped += (f" and the best {self.prescreen_keep} of the next {self.prescreen} re-ranked on "
+                       f"{self.prescreen_waypoints} waypoints (as the screen's first pass),")
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
                   f"{self._kkt(self.screen_linear_solver)}{self._repeated()}, if the path has more)"

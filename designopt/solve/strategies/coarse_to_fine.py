@@ -18,10 +18,10 @@ design optimal for the full path. Stages, each across every problem:
    over and those kept spread over the branches their walks reach first; with ``rebranch_extra`` > 0 (the default's
    30) a leader's drawn starts all stay and that many more join them, spread over the branches they miss.
 2. ``prescreen`` (with ``search.prescreen`` > 0, on fewer waypoints than the screen's): the ``prescreen`` best
-   distinct coarse optima lifted to ``prescreen_waypoints`` and solved warm as the screen's first pass solves (a
-   smaller problem's more, as for the screen): a second ranking, on more waypoints than the exploration's, of more
-   candidates than the screen can afford; the screen takes them alternately by either ranking
-   (`alternately_ranked`).
+   distinct coarse optima after those the screen takes, lifted to ``prescreen_waypoints`` and solved warm as the
+   screen's first pass solves (a smaller problem's more, as for the screen); the ``prescreen_keep`` best of them
+   join the screen's candidates (`best_prescreened`): coarse optima the exploration's few waypoints rank low but
+   more waypoints rank high, for a fraction of the screen's cost per candidate.
 3. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    (or prescreened) optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem
    of several more, on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within
@@ -117,21 +117,12 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     return tasks
 
 
-def alternately_ranked(explored, prescreened, count: int) -> list:
-    """The ``count`` explored (task, solution) pairs the screen lifts after a prescreen: the prescreened candidates'
-    coarse optima (``prescreened``: (task, solution) of each, its task's start the coarse optimum) taken alternately
-    by their coarse cost and by their prescreened cost (one that does not track last), each ranking skipping what
-    the other took. The coarse ranking keeps the candidates the screen would take without a prescreen, the first
-    half of them; the prescreen's brings those the exploration's few waypoints rank low."""
+def best_prescreened(explored, prescreened, keep: int) -> list:
+    """The explored (task, solution) pairs of the ``keep`` prescreened candidates (``prescreened``: (task, solution)
+    of each, its task's start the coarse optimum) whose prescreened optima track at the lowest design cost."""
     by_seed = {task.seed: (task, sol) for task, sol in explored}
-    coarse = sorted(prescreened, key=lambda d: d[0].start.solution.metrics.design_cost)
-    finer = sorted(prescreened, key=lambda d: d[1].metrics.design_cost if d[1].metrics.tracks else np.inf)
-    taken: list[int] = []
-    for a, b in zip(coarse, finer, strict=True):
-        for task, _ in (a, b):
-            if len(taken) < count and task.seed not in taken:
-                taken.append(task.seed)
-    return [by_seed[seed] for seed in taken]
+    tracking = sorted((d for d in prescreened if d[1].metrics.tracks), key=lambda d: d[1].metrics.design_cost)
+    return [by_seed[task.seed] for task, _ in tracking[:keep]]
 
 
 def better_pass(done: list[tuple[Task, object]]) -> list[tuple[Task, object]]:
@@ -216,24 +207,31 @@ def plan(jobs, search):
     if screened:
         sub = [jobs[k] for k in screened]
         screens = screening([job.problem for job in jobs], search)
-        pool = {k: explored[k] for k in screened}
         choose = {"per_form": search.screen_per_form, "new_leaders": search.screen_new_leaders}
+        extra = {k: [] for k in screened}  # prescreened coarse optima that join the screen's candidates
         pre = [k for k in screened if search.prescreen
                and search.prescreen_waypoints < (screens[k][1] or jobs[k].problem.toolpath.n)]
-        if pre:  # a second ranking of more candidates, on more waypoints, as the screen's first pass solves
+        if pre:  # the next coarse optima re-ranked on more waypoints, as the screen's first pass solves
             first_mu, first_solver = search.screen_passes[0]
-            count = {k: round(search.prescreen * screens[k][0] / search.screen) for k in pre}  # as `screening`
-            tasks = [task for k in pre
-                     for task in lifted_tasks([jobs[k]], [explored[k]], count[k], "prescreen",
-                                              search.prescreen_waypoints, search, search.screen_max_iter,
-                                              mu_init=first_mu, linear_solver=first_solver, **choose)]
+            tasks = []
+            for k in pre:
+                count, more = screens[k][0], round(search.prescreen * screens[k][0] / search.screen)
+                taken = {t.seed for t in lifted_tasks([jobs[k]], [explored[k]], count, "screen", screens[k][1],
+                                                      search, **choose)}
+                tasks += [t for t in lifted_tasks([jobs[k]], [explored[k]], count + more, "prescreen",
+                                                  search.prescreen_waypoints, search, search.screen_max_iter,
+                                                  mu_init=first_mu, per_form=search.screen_per_form,
+                                                  linear_solver=first_solver)
+                          if t.seed not in taken][:more]
             for k, done in zip(pre, by_job([jobs[k] for k in pre], (yield tasks)), strict=True):
-                pool[k] = alternately_ranked(explored[k], done, screens[k][0])  # each one screened
+                extra[k] = best_prescreened(explored[k], done,
+                                            round(search.prescreen_keep * screens[k][0] / search.screen))
         tasks = [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
                  if i < len(search.passes_for(jobs[k].problem.chain.n_moving))
-                 for task in lifted_tasks([jobs[k]], [pool[k]], screens[k][0], numbered_stage("screen", i),
-                                          screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
-                                          linear_solver=solver, **({} if k in pre else choose))]
+                 for found, count, how in ((explored[k], screens[k][0], choose), (extra[k], len(extra[k]), {}))
+                 for task in lifted_tasks([jobs[k]], [found], count, numbered_stage("screen", i), screens[k][1],
+                                          search, search.screen_max_iter, mu_init=screen_mu, linear_solver=solver,
+                                          **how)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
