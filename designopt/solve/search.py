@@ -55,10 +55,10 @@ class Search:
     more again per leader, their designs moved around the leader's by ``rebranch_moved_perturbation``, spread over
     the branches all the leader's other starts miss, out of ``rebranch_moved_pool`` drawn in a block of their own,
     `more_start`; both are `more_blocks`); the
-    ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before
-    other forms; None: by cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped
-    when the path has no more waypoints), with the cheapest distinct optimum of each of up to
-    ``screen_new_leaders`` second-round leaders whose starts have none among them (`leader_of`), and with
+    ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
+    cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
+    more waypoints), with the cheapest distinct optimum of each of up to ``screen_new_leaders`` second-round leaders
+    whose starts have none among them (`leader_of`), and with
     ``prescreen`` > 0 the ``prescreen_keep`` best of the ``prescreen`` next distinct coarse optima solved warm on
     ``prescreen_waypoints`` as the screen's first pass solves (stage ``prescreen``; skipped when the screen's
     waypoints are no more: `strategies.coarse_to_fine.best_prescreened`), and the

@@ -23,8 +23,8 @@ design optimal for the full path. Stages, each across every problem:
    join the screen's candidates (`best_prescreened`): coarse optima the exploration's few waypoints rank low but
    more waypoints rank high, for a fraction of the screen's cost per candidate.
 3. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
-   (or prescreened) optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem
-   of several more, on more waypoints: `screening`) lifted to ``screen_waypoints`` waypoints, solved warm within
+   optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem of several more,
+   on more waypoints: `screening`), and the prescreen's, lifted to ``screen_waypoints`` waypoints, solved warm within
    ``screen_max_iter`` and ranked again there: the coarse ranking alone often puts a design that lifts badly ahead
    of one that lifts well. Once per barrier of ``screen_mu_init`` and linear solver of ``screen_linear_solver``
    (stages ``screen``, ``screen2``, ...: `Search.screen_passes`; a small arm the first pass only, when
