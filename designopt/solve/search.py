@@ -453,10 +453,14 @@ PRESETS: dict[str, Search] = {
     # exact ones"). The best of up to four forms not among the leaders instead of two (`rebranch_new_forms`), each
     # leader's starts numbered in a block of its own (`leader_start`): on seeds never run before (circle and physical
     # stiffness 1624-1633, main job 1767-1776) seeds better / worse 0 / 0, 1 / 0, 0 / 0 at 1.106x, 1.111x, 1.114x the
-    # solve time (docs/benchmarks.md, "Four forms not among the leaders")
+    # solve time (docs/benchmarks.md, "Four forms not among the leaders"). The best 8 of the next 48 distinct coarse
+    # optima on 20 waypoints added to the screen's 24 (`prescreen`): on seeds never run before (circle and physical
+    # stiffness 1654-1663, main job 1797-1806) seeds better / worse 2 / 0, 1 / 0, 1 / 0 at 1.164x, 1.158x, 1.156x the
+    # solve time (docs/benchmarks.md, "The screen's candidates prescreened on 20 waypoints")
     "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
                       refine_mu_init=(None, 1e-6), rebranch_new_forms=4, reflect=3, reflect_within=1.05,
-                      rebranch_extra=30, rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10),
+                      rebranch_extra=30, rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10,
+                      prescreen=48),
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
