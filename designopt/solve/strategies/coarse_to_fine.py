@@ -110,11 +110,17 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     for job, done in zip(jobs, found, strict=True):
         problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
         profile, continuation = solve_setup(job, search, warm)
-        lineages = [search.leader_of(task.seed) for task, _ in done] if new_leaders else None
-        for i in distinct_best([sol for _, sol in done], count, search.distinct, per_form,
-                               same_arm_cost=search.same_arm_cost, lineages=lineages, new_lineages=new_leaders):
+        for i in picked(done, count, search, per_form, new_leaders):
             tasks.append(Task(job.case, stage, problem, job.transcription, profile, Lifted(done[i][1]), continuation))
     return tasks
+
+
+def picked(done, count: int, search, per_form: int | None = None, new_leaders: int = 0) -> list[int]:
+    """Indices into ``done`` ((task, solution) pairs) of the solutions `lifted_tasks` lifts: `optima.distinct_best`
+    with the search's ``distinct`` and ``same_arm_cost``, each solution's lineage its second-round leader."""
+    lineages = [search.leader_of(task.seed) for task, _ in done] if new_leaders else None
+    return distinct_best([sol for _, sol in done], count, search.distinct, per_form,
+                         same_arm_cost=search.same_arm_cost, lineages=lineages, new_lineages=new_leaders)
 
 
 def best_prescreened(explored, prescreened, keep: int) -> list:
@@ -216,8 +222,7 @@ def plan(jobs, search):
             tasks = []
             for k in pre:
                 count, more = screens[k][0], round(search.prescreen * screens[k][0] / search.screen)
-                taken = {t.seed for t in lifted_tasks([jobs[k]], [explored[k]], count, "screen", screens[k][1],
-                                                      search, **choose)}
+                taken = {explored[k][i][0].seed for i in picked(explored[k], count, search, **choose)}
                 tasks += [t for t in lifted_tasks([jobs[k]], [explored[k]], count + more, "prescreen",
                                                   search.prescreen_waypoints, search, search.screen_max_iter,
                                                   mu_init=first_mu, per_form=search.screen_per_form,
