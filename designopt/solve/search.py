@@ -364,99 +364,27 @@ DEGENERATE_JACOBIAN = (*REGULARISED_CONSTRAINTS, ("ipopt.alpha_for_y", "min-dual
 PAPER = Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0))
 
 PRESETS: dict[str, Search] = {
-    # a structure sweep's per-structure search: a quarter of the default's starts, tighter caps, no second
-    # round on new joint branches (on the K = I sweep it took 1.5x the wall, moved the structure bests both ways and
-    # reached 5 instead of 8 of 10 references: its extra coarse optima crowd out, of the 2 refined, the ones that
-    # lift well; docs/decisions.md), and IPOPT set for degenerate Jacobians (most of a sweep's structures have fewer
-    # than six joints or prismatic ones). Each structure's best reflected across its length bounds after the neighbour
-    # starts (`reflect`): on the K = I sweep's fresh seeds 2101 and 2102, 42 and 36 more solves (0.7 % and 0.6 % of
-    # the sweep's solver time) lowered 8 and 7 structure bests by more than 1 % (up to 0.73x), none higher. The best 4
-    # distinct coarse optima refined, not 2: on seeds 2101-2103 (replays from the refine on), references within 1.10x
-    # 6 -> 6, 5 -> 7, 3 -> 4 of 10; structure bests lower / higher by > 1 % 22 / 2, 21 / 6, 15 / 8; at 1.20x, 1.17x
-    # and 1.09x the solver time (docs/benchmarks.md, "Sweep"). The 4 chosen by a screen: the best 12 distinct coarse
-    # optima lifted to 20 waypoints and ranked there (RRPR's best coarse optimum, 0.0152 on 10 waypoints, ends at
-    # 0.13-0.14 on the full path on seeds 2114-2116, where others end at 0.024): on fresh seeds 2118 and 2119 (replays
-    # from the screen on), structure bests lower / higher by > 1 % 27 / 16 and 35 / 17 of 124 (geometric mean 0.97x
-    # both), references within 1.10x 7 -> 7 and 6 -> 6, at 1.24x and 1.15x the solver time after the exploration
-    # (docs/decisions.md). The exploration's KKT systems by the LDLᵀ, as in the default: on fresh seeds 2123 and
-    # 2124 (whole sweeps against main's), exploration solver time 0.60x and 0.59x, the sweep's wall 0.79x and 0.80x,
-    # structure bests lower / higher by > 1 % 32 / 20 and 25 / 27, references within 1.10x 3 -> 4 and 5 -> 4
-    # (docs/decisions.md, "Speed"). The screen's too (20 waypoints, below the LDLᵀ's MATCHED_FROM; the refine's 40
-    # gain nothing): on fresh seeds 2130 and 2131 (replays from the screen on, side by side) the screen's solver time
-    # 0.69x, the replayed stages' 0.894x both, structure bests lower / higher by > 1 % 9 / 12 and 19 / 7, references
-    # within 1.10x 4 -> 4 and 4 -> 5 (docs/decisions.md, "Speed"). And each candidate screened a second time, by
-    # MUMPS, ranked for the refine by its better pass (the two factorisations lead a screen into different basins,
-    # either way round): on fresh seeds 2151 and 2152 (replays from the screen on), references within 1.10x 5 -> 5 and
-    # 7 -> 8, structure bests lower / higher by > 1 % 13 / 6 and 6 / 11, at 1.16x and 1.14x the sweep's solver time
-    # (docs/decisions.md, 2026-11-30); the second pass only where the arm has 5 or more joints (the 3- and 4-joint
-    # structures' passes end alike): on fresh seeds 2154 and 2155 (replays from the refine on) the same references,
-    # structure bests lower / higher by > 1 % 0 / 0 and 0 / 1, at 0.93x the sweep's solver time (docs/decisions.md,
-    # 2026-11-30). An arm of fewer than 5 joints explores from starts perturbed by 0.6 (its designs are structural and
-    # far from the generic one: RRPR's best has links of 1.5-1.9 m): on seeds 2154 and 2155 (replays, not tuned on)
-    # references within 1.10x 5 -> 6 and 7 -> 7, structure bests lower / higher by > 1 % 5 / 1 and 4 / 3, at 1.00x and
-    # 1.03x the solver time (docs/decisions.md, 2026-11-30)
-    # A structure with fewer joints explores with more starts, about what a 6-joint structure's 40 cost, at most 160
-    # (`small_problem_starts`; 5, 4, 3 joints: 56, 84, 139 starts): on fresh K = I seeds 2141 and 2142 (whole
-    # sweeps, side by side), references within 1.10x 4 -> 4 and 5 -> 7, structure bests lower / higher by > 1 % 5 / 2
-    # and 8 / 6, at 1.107x and 1.088x the solver time (docs/decisions.md, 2026-11-29). And screens as many times more
-    # candidates on more waypoints, its screen problem the size of a 6-joint one's (`screening`; 5, 4, 3 joints: 17
-    # on 25, 25 on 32, 42 on the full path): on fresh seeds 2144 and 2145 (replays from the screen on, side by
-    # side), references within 1.10x 6 -> 7 and 7 -> 7, structure bests lower / higher by > 1 % 12 / 6 and 13 / 6,
-    # at 1.021x and 1.028x the sweep's solver time (docs/decisions.md, 2026-11-29)
+    # A structure sweep's search per structure (`designopt sweep-structures`): a quarter of the default's starts,
+    # tighter caps and no second round on new joint branches; IPOPT set for degenerate Jacobians (most of a sweep's
+    # structures have fewer than six joints or prismatic ones); the exploration and the screen (20 waypoints) by the
+    # LDLᵀ, each candidate screened a second time by MUMPS where the arm has 5 or more joints and ranked by its
+    # better pass; the best 4 refined; each structure's best reflected across its length bounds. An arm of fewer
+    # joints gets more starts and screens (`small_problem_starts`, `screening`), perturbed by 0.6 below 5 joints.
+    # Each setting was judged on fresh sweep seeds against the preset before it: docs/benchmarks.md "Sweep",
+    # docs/decisions.md.
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
                     explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), small_arm_screens_once=True,
                     small_arm_perturbation=0.6,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
-    # `designopt run`: 160 starts and 160 on new joint branches, explored with the LDLᵀ (its exploration solves cost
-    # 0.59x MUMPS's; the screen and the refine keep MUMPS, which pivots). On 20 evaluation seeds (1201-1220) against
-    # 80 starts and MUMPS: the main job 8 -> 15 within 1.10x of the best design known, physical stiffness 6 -> 10,
-    # the circle 3 -> 3, at 1.45-1.6x the wall. The best 24 distinct coarse optima screened instead of 12: on 20
-    # other evaluation seeds (1241-1260) seeds better / worse 2 / 1 (main job), 7 / 1 (physical stiffness), 5 / 0
-    # (the circle), at 1.08x the wall. Each candidate refined twice, from the warm start's barrier and from 1e-6 (a
-    # refine from 1e-6 stays in its screened start's basin): on seeds 1261-1280 within 1.10x of the best known, main
-    # job 14 -> 15, physical stiffness 8 -> 13, circle 6 -> 9, no seed worse. Each candidate screened twice too, from
-    # the same two barriers, ranked by the better: on seeds 1281-1300 (replays of the runs from the screen on)
-    # seeds better / worse 3 / 0 (main job), 5 / 0 (physical stiffness), 5 / 0 (circle); on seeds 1301-1320, not
-    # chosen on, 4 / 0, 6 / 0 and 5 / 2 (the circle's distribution unchanged); at 1.18-1.33x the wall. The second
-    # round also from the cheapest optimum of each of 2 forms its 8 leaders lack (the best design's form is often
-    # not among them): on seeds 1341-1360 (main job) and 1321-1340 (the other two), replays from the second round,
-    # seeds better / worse 3 / 0, 0 / 0, 5 / 0 (the circle 5 -> 8 within 1.10x), about 1.07x the solve time; 4 forms
-    # instead of 2 changed no answer on seeds 1361-1380 / 1341-1360, and neither did a cap of 6 candidates of one form
-    # on the screen (`screen_per_form`: 1 seed better, 3 worse), nor 36 screened instead of 24 on the main job and the
-    # circle (seeds 1381-1400 / 1361-1380; physical stiffness 2 better, at 1.16-1.18x the solve time)
-    # (docs/benchmarks.md, "Search"; docs/decisions.md, 2026-11-26/27). Then the answer reflected across its length
-    # bounds, up to 3 rounds (`reflect`): on seeds 1421-1440 (main job) and 1401-1420 (the other two), replays of the
-    # default's runs, seeds better / worse 3 / 0, 9 / 0, 5 / 0 (main job worst 1.330 -> 1.209x, the circle's median
-    # 1.898 -> 1.743x) at 1.002x, 1.035x, 1.022x the solve time. Every start's IK walk pulled home (`init: home`:
-    # around a closed path the minimum-norm walk drifts along a redundant arm's self-motion): on seeds never run
-    # before, within 1.10x of the best known circle 5 -> 10 of 20 (median 2.053 -> 1.386x; seeds 1441-1460),
-    # physical stiffness 14 -> 18 of 20 (worst 1.344 -> 1.177x; 1441-1460), main job 35 -> 36 of 40 (p90 1.163 ->
-    # 1.065x, worst 1.278 -> 1.245x; 1481-1520, seeds better / worse 10 / 10; on 1461-1480 before it 4 / 5, worst
-    # 1.238 -> 1.211x), at 0.99-1.02x the solve time (docs/benchmarks.md, "IK walks pulled home"). The first reflect
-    # round over every refined optimum within 1.05x of the best (`reflect_within`): on seeds never run before (main
-    # job 1587-1606, the other two 1484-1503), replays of the default's runs, seeds better / worse 5 / 0, 3 / 0, 1 / 0
-    # at 1.006x, 1.036x, 1.017x the solve time (docs/benchmarks.md, "Runner-up optima reflected"). Each second-round
-    # leader's 20 drawn starts kept and 5 more spread over the branches they miss (`rebranch_extra`): on seeds never
-    # run before (circle 1544-1563, physical stiffness 1544-1553, main job 1687-1696), replays of the default's runs,
-    # seeds better / worse 5 / 0, 4 / 0, 2 / 0 at 1.066x, 1.079x, 1.085x the solve time (docs/benchmarks.md, "Five more
-    # starts per leader"); 15 such starts (of 50 drawn) instead of 5: on seeds never run before (circle 1564-1573,
-    # physical stiffness 1554-1563, main job 1697-1706), replays of the default's runs, seeds better / worse 1 / 0,
-    # 3 / 0, 3 / 0 at 1.149x, 1.137x, 1.170x the solve time (docs/benchmarks.md, "Fifteen more starts per leader");
-    # 30 (the same 50 drawn; the first 15 those of 15): on seeds never run before (circle and physical stiffness
-    # 1574-1583, main job 1707-1716) seeds better / worse 1 / 1, 2 / 0, 0 / 0 at 1.200x, 1.171x, 1.203x the solve time
-    # (docs/benchmarks.md, "Thirty more starts per leader"). The same arm placed elsewhere at a cost within 0.2 % one
-    # optimum (`same_arm_cost`): on seeds never run before (circle and physical stiffness 1584-1593, main job
-    # 1717-1726) seeds better / worse 0 / 0, 0 / 0, 1 / 0 at 1.001x, 0.997x, 1.003x the solve time (docs/benchmarks.md,
-    # "The same arm placed elsewhere"). Ten more starts per leader with its design moved by 0.1 (`rebranch_moved`):
-    # on seeds never run before (circle and physical stiffness 1604-1613, main job 1737-1746) seeds better / worse
-    # 1 / 0, 1 / 0, 0 / 0 at 1.117x, 1.110x, 1.112x the solve time (docs/benchmarks.md, "Moved starts beside a leader's
-    # exact ones"). The best of up to four forms not among the leaders instead of two (`rebranch_new_forms`), each
-    # leader's starts numbered in a block of its own (`leader_start`): on seeds never run before (circle and physical
-    # stiffness 1624-1633, main job 1767-1776) seeds better / worse 0 / 0, 1 / 0, 0 / 0 at 1.106x, 1.111x, 1.114x the
-    # solve time (docs/benchmarks.md, "Four forms not among the leaders"). The best 8 of the next 48 distinct coarse
-    # optima on 20 waypoints added to the screen's 24 (`prescreen`): on seeds never run before (circle and physical
-    # stiffness 1654-1663, main job 1797-1806) seeds better / worse 2 / 0, 1 / 0, 1 / 0 at 1.164x, 1.158x, 1.156x the
-    # solve time (docs/benchmarks.md, "The screen's candidates prescreened on 20 waypoints")
+    # `designopt run`: 160 starts on 10 waypoints walked home, explored with the LDLᵀ; a second round on new joint
+    # branches from the 8 best distinct coarse optima and the best of up to 4 forms not among them (20 drawn starts
+    # each, 30 more over the branches those miss, 10 more with the design moved by 0.1); the 24 best distinct coarse
+    # optima and the best 8 of the next 48 (prescreened on 20 waypoints) screened on 40 waypoints from two barriers;
+    # the best 4 refined on the full path from two barriers; every refined optimum within 1.05x of the best reflected
+    # across its length bounds, then the best (3 rounds at most); the same arm placed elsewhere at a cost within
+    # 0.2 % one optimum. Each
+    # setting was judged on evaluation seeds never tuned on, against the preset before it (seeds better / worse,
+    # solve time): docs/benchmarks.md "Search", docs/decisions.md.
     "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
                       refine_mu_init=(None, 1e-6), rebranch_new_forms=4, reflect=3, reflect_within=1.05,
                       rebranch_extra=30, rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10,
