@@ -910,6 +910,47 @@ def test_the_prescreen_adds_the_best_of_the_next_coarse_optima_on_more_waypoints
     assert "re-ranked on 15" not in replace(search, prescreen=0).describe()
 
 
+def test_refine_from_coarse_refines_each_refined_candidate_again_from_its_coarse_optimum():
+    """`Search.refine_from_coarse`: besides a pass per barrier of ``refine_mu_init`` from the screened solutions,
+    each of the ``refine`` candidates is refined once more from the coarse optimum its screen was lifted from (the
+    same start number), on the full path, from the warm start's barrier, in the stage after the barriers' passes;
+    the candidates the refine does not take get no such pass. Driven through the plan."""
+    problem = problem_from_config(parse_config({}))
+    a = (0, 0, 1, 0, 1)
+    job = Job("", problem)
+
+    def optima(costs, seeds):
+        out = [_optimum(problem, cost, a, 0.1 * k) for k, cost in enumerate(costs)]
+        for sol, seed in zip(out, seeds, strict=True):
+            sol.raw.seed = seed
+        return out
+
+    def refines(search):
+        plan = coarse_to_fine.plan([job], search)
+        explore = next(plan)
+        sols = optima([1.0, 2.0, 3.0, 4.0, 5.0, 6.0], [t.seed for t in explore])
+        screen = plan.send(list(zip(explore, sols, strict=True)))
+        assert [t.start.solution for t in screen] == sols[:3]
+        # on the screen's waypoints the coarse 3rd screens cheapest, then the 1st; the 2nd is not refined
+        screened = optima([2.5, 9.0, 0.5], [t.seed for t in screen])
+        return sols, screened, plan.send(list(zip(screen, screened, strict=True))[::-1])
+
+    search = Search(starts=6, rebranch=0, screen=3, screen_waypoints=20, refine=2, refine_mu_init=(None, 1e-6),
+                    refine_from_coarse=True)
+    sols, screened, refine = refines(search)
+    assert [t.stage for t in refine] == ["refine", "refine", "refine2", "refine2", "refine3", "refine3"]
+    assert [t.start.solution for t in refine if t.stage != "refine3"] == [screened[2], screened[0]] * 2
+    assert [t.start.solution for t in refine if t.stage == "refine3"] == [sols[0], sols[2]]  # their coarse optima
+    assert {t.problem.toolpath.n for t in refine} == {problem.toolpath.n}  # the full path
+    third = [t for t in refine if t.stage == "refine3"]
+    assert {dict(t.profile.options).get("ipopt.mu_init") for t in third} == {dict(refine[0].profile.options)
+                                                                             .get("ipopt.mu_init")}
+    assert "and once from its coarse optimum" in search.describe()
+
+    _, screened, refine = refines(replace(search, refine_from_coarse=False))
+    assert [t.stage for t in refine] == ["refine", "refine", "refine2", "refine2"]
+    assert "from its coarse optimum" not in replace(search, refine_from_coarse=False).describe()
+
 @pytest.fixture(scope="module")
 def yaw_placed(milling_12):
     """(problem, known, single): the PUMA-560 placed by its yaw alone, the optimum over yaw by an exhaustive grid (24

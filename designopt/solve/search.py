@@ -81,8 +81,12 @@ class Search:
     warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate refined once per value (stages
     ``refine``, ``refine2``, ...; the answer is the best of all): from a small one a refine stays in the basin its
     screened start is in, from the warm start's it sometimes walks into a better one and more often into a worse
-    one. ``screen_mu_init``: the same for the screen (stages
-    ``screen``, ``screen2``, ...), each candidate ranked for the refine by its better pass. ``hop``: after the
+    one. ``refine_from_coarse``: each refined candidate refined once more, from its coarse optimum lifted straight
+    to the full path and solved warm from the warm start's barrier (the stage after the barriers' passes, e.g.
+    ``refine3``): a screened solution fits the screen's waypoints and may leave the path between them by more than
+    the velocity limits allow, so its lift can start outside its basin. ``screen_mu_init``: the same as
+    ``refine_mu_init`` for the screen (stages ``screen``, ``screen2``, ...), each candidate ranked for the refine by
+    its better pass. ``hop``: after the
     strategy and the neighbour step, that many restarts around each of the ``hop_incumbents`` best distinct
     full-path optima, on a new joint branch with the design moved by ``hop_perturbation`` (as
     ``rebranch_extra_perturbation``), solved on the screen's waypoints (stage ``hop``), the ``hop_refine`` best
@@ -139,6 +143,7 @@ class Search:
     small_arm_screens_once: bool = False
     small_arm_perturbation: float | None = None
     refine_mu_init: tuple[float | None, ...] = (None,)
+    refine_from_coarse: bool = False
     reflect: int = 0
     reflect_within: float | None = None
     hop: int = 0
@@ -319,6 +324,8 @@ class Search:
                  if self.rebranch else "")
         kkt = self._kkt((self.explore_linear_solver,))
         barrier = _barriers(self.refine_mu_init)
+        if self.refine_from_coarse and self.screen:
+            barrier += ", and once from its coarse optimum"
         if self.small_problem_starts > 1:
             drawn += (f" (a problem smaller than the largest up to {self.small_problem_starts:g}x as many, "
                       f"about its cost)")

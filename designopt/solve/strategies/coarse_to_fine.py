@@ -31,7 +31,9 @@ design optimal for the full path. Stages, each across every problem:
    ``small_arm_screens_once``), each candidate ranked by its better pass.
 4. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
-   once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), the best of all kept.
+   once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), and with ``refine_from_coarse``
+   once more from each one's coarse optimum lifted straight to the full path (the next stage: its screened
+   solution fits the screen's waypoints and may lift badly), the best of all kept.
 """
 
 from __future__ import annotations
@@ -103,16 +105,28 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
     starts with none among them, `Search.leader_of`) lifted to ``waypoints`` (None: the full path), each solved warm
     within ``max_iter`` iterations (None: the profile's own cap), from barrier parameter ``mu_init`` (None: the warm
     start's own), its KKT systems by ``linear_solver`` (None: the profile's)."""
+    return [task for job, done in zip(jobs, found, strict=True)
+            for task in lifted(job, [done[i][1] for i in picked(done, count, search, per_form, new_leaders)], stage,
+                               waypoints, search, max_iter, mu_init, linear_solver)]
+
+
+def lifted(job, solutions, stage: str, waypoints: int | None, search, max_iter: int | None = None,
+           mu_init: float | None = None, linear_solver: str | None = None) -> list[Task]:
+    """A task of ``stage`` per solution of ``solutions`` (of ``job``'s task sampled otherwise) lifted to
+    ``waypoints`` (None: the full path) and solved warm, as `lifted_tasks` solves them."""
     warm = search.profile.warmed().capped(max_iter).solved_by(linear_solver)
     if mu_init is not None:
         warm = warm.with_options(**{"ipopt.mu_init": mu_init})
-    tasks = []
-    for job, done in zip(jobs, found, strict=True):
-        problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
-        profile, continuation = solve_setup(job, search, warm)
-        for i in picked(done, count, search, per_form, new_leaders):
-            tasks.append(Task(job.case, stage, problem, job.transcription, profile, Lifted(done[i][1]), continuation))
-    return tasks
+    problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
+    profile, continuation = solve_setup(job, search, warm)
+    return [Task(job.case, stage, problem, job.transcription, profile, Lifted(sol), continuation) for sol in solutions]
+
+
+def coarse_optima(explored, refined) -> list:
+    """The coarse optima (solutions of ``explored``, a job's (task, solution) pairs) that the screened solutions
+    ``refined`` were lifted from: the same start numbers."""
+    numbers = {sol.raw.seed for sol in refined}
+    return [sol for task, sol in explored if task.seed in numbers]
 
 
 def picked(done, count: int, search, per_form: int | None = None, new_leaders: int = 0) -> list[int]:
@@ -242,6 +256,11 @@ def plan(jobs, search):
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
                for task in lifted_tasks(jobs, candidates, search.refine, numbered_stage("refine", i), None, search,
                                         mu_init=refine_mu)]
+    if search.refine_from_coarse:  # each screened candidate refined again from its coarse optimum
+        stage = numbered_stage("refine", len(search.refine_mu_init))
+        for k in screened:
+            chosen = [candidates[k][i][1] for i in picked(candidates[k], search.refine, search)]
+            refines += lifted(jobs[k], coarse_optima(explored[k], chosen), stage, None, search)
     final = by_job(jobs, (yield refines))
     return [Searched(job, e, f) for job, e, f in zip(jobs, explored, final, strict=True)]
 
