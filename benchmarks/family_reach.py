@@ -1,0 +1,127 @@
+"""Where a search loses the best design's family: never reached, not screened, or lost after the screen.
+
+A coarse optimum is of the *best family* when every link length of its arm (|a| and |d| of each link, not the
+placement) is within ``--within`` metres of the best design known's (``--reference``): the family the screen and
+the refine can carry to the best design, even where its coarse cost on 10 waypoints is 1.5-2x the best's. For
+each RUN (a directory `search_seeds.py --out DIR` keeps, DIR/<name>/s<seed>) this reads every tracking coarse
+optimum's design (its solution file) and prints:
+
+- per kind of exploration start (first round; a second-round leader's drawn starts, its extra starts
+  `Search.rebranch_extra`, its moved starts `Search.rebranch_moved`): starts, family coarse optima, and starts per
+  family optimum;
+- per run: its family coarse optima (how many, the best one's coarse rank and coarse cost over the best known),
+  the best screen of a family candidate, the answer, and where the family was lost: ``never reached`` (no family
+  coarse optimum), ``not screened``, ``screened, not landed`` (no family screen within 1.10x), ``lost in the
+  refine`` (a family screen within 1.10x, the answer above it) or ``reached`` (the answer within 1.10x).
+
+Nothing is solved. The length test suits a task whose near-best designs are one arm (the circle with a keep-out
+zone); on the main job designs within 1.10x of the best known have other lengths too (20 of 20 runs reach 1.10x
+with 7 family optima among 17,600), and under a physical stiffness model many designs share the lengths.
+
+    .venv/bin/python benchmarks/family_reach.py DIR/circle_standoff/s* \\
+        --reference benchmarks/reference/circle_standoff_best_known.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
+from designopt.initial_guess import start_index
+from designopt.problem import problem_from_config
+from designopt.tables import stage_kind
+
+ROOT = Path(__file__).resolve().parent.parent
+WITHIN = 1.10  # an answer or screen "within" the best known: at most this factor above it
+
+
+def start_kind(search, number: int) -> str:
+    """Which kind of exploration start ``number`` is: first round, or a second-round leader's drawn, extra or
+    moved start (`Search.leader_start`, `Search.more_blocks`)."""
+    rank = search.leader_of(number)
+    if rank is None:
+        return "first round"
+    index = start_index(number, search.seed)
+    r = next(r for r in range(search.rebranch_rounds)
+             if 0 <= index - search.leader_start(r, rank) < search.leader_width)
+    offset = index - search.leader_start(r, rank)
+    if offset < search.leader_drawn:
+        return "drawn"
+    for block, (count, size, perturbation) in enumerate(search.more_blocks):
+        begin = search.more_start(block, r, rank) - search.leader_start(r, rank)
+        if count > 0 and begin <= offset < begin + size:
+            return "extra" if not perturbation else f"moved by {perturbation:g}"
+    return "other"
+
+
+def lengths(design_joints: dict, names: list[str]) -> np.ndarray:
+    return np.abs([design_joints[name] for name in names])
+
+
+def run_rows(run: Path, reference: dict, within: float) -> tuple[pd.DataFrame, dict]:
+    """(one row per exploration solve: its start kind and whether it is a tracking family optimum; the run's
+    verdict row)."""
+    cfg = load_config(run / "config.yaml")
+    search, chain = search_from_config(cfg), problem_from_config(cfg).chain
+    placement = {j.name for j in chain.placement_joints}
+    names = [j.name for j in chain.design if j.kind == "length" and j.name not in placement]
+    best = lengths(reference["design_joints"], names)
+    known = reference["metrics"]["design_cost"]
+    summary = pd.read_csv(run / "summary.csv")
+    kind = summary["stage"].astype(str).map(stage_kind)
+    tracks = summary["tracks"].astype(bool)
+    explored = summary[kind == "explore"]
+    family = [bool(ok) and np.abs(lengths(json.loads((run / f).read_text())["design_joints"], names) - best).max()
+              <= within for f, ok in zip(explored["solution_file"], explored["tracks"].astype(bool), strict=True)]
+    rows = pd.DataFrame({"run": run.name, "kind": [start_kind(search, int(s)) for s in explored["seed"]],
+                         "family": family, "seed": explored["seed"].to_numpy(),
+                         "cost": explored["design_cost"].to_numpy() / known, "tracks": explored["tracks"].astype(bool)})
+    ranked = rows[rows["tracks"]].sort_values("cost", kind="stable").reset_index(drop=True)
+    fam = ranked[ranked["family"]]
+    screens = summary[(kind == "screen") & tracks & summary["seed"].isin(fam["seed"])]
+    screened = screens["design_cost"].min() / known if len(screens) else np.nan
+    answer = summary[kind.isin(["refine", "reflect"]) & tracks]["design_cost"].min() / known
+    if answer <= WITHIN:
+        verdict = "reached"
+    elif fam.empty:
+        verdict = "never reached"
+    elif screens.empty:
+        verdict = "not screened"
+    elif screened > WITHIN:
+        verdict = "screened, not landed"
+    else:
+        verdict = "lost in the refine"
+    return rows, {"run": run.name, "family optima": len(fam),
+                  "best family rank": int(fam.index[0]) if len(fam) else None,
+                  "its coarse cost": round(float(fam["cost"].iloc[0]), 3) if len(fam) else None,
+                  "best family screen": round(float(screened), 3), "answer": round(float(answer), 3),
+                  "where": verdict}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("runs", nargs="+", type=Path)
+    parser.add_argument("--reference", required=True, help="the best design known (a solution file)")
+    parser.add_argument("--within", type=float, default=0.06, help="family: every link length within this [m]")
+    args = parser.parse_args()
+    reference = json.loads((ROOT / args.reference).read_text())
+    done = [run_rows(run, reference, args.within) for run in args.runs]
+    starts = pd.concat([rows for rows, _ in done], ignore_index=True)
+    per_kind = starts.groupby("kind").agg(starts=("family", "size"), family=("family", "sum"))
+    per_kind["starts per family optimum"] = (per_kind["starts"] / per_kind["family"].replace(0, np.nan)).round()
+    print(f"{len(starts)} exploration solves of {len(args.runs)} runs; family: every link length within "
+          f"{args.within} m of the best known's\n")
+    print(per_kind.to_string())
+    runs = pd.DataFrame([verdict for _, verdict in done])
+    print("\n" + runs.to_string(index=False))
+    print("\n" + ", ".join(f"{n} {where}" for where, n in runs["where"].value_counts().items()))
+
+
+if __name__ == "__main__":
+    main()
