@@ -112,8 +112,8 @@ def lifted_tasks(jobs, found, count: int, stage: str, waypoints: int | None, sea
 
 def lifted(job, solutions, stage: str, waypoints: int | None, search, max_iter: int | None = None,
            mu_init: float | None = None, linear_solver: str | None = None) -> list[Task]:
-    """A task of ``stage`` per solution of ``solutions`` (of ``job``'s task sampled otherwise) lifted to
-    ``waypoints`` (None: the full path) and solved warm, as `lifted_tasks` solves them."""
+    """A task of ``stage`` per solution of ``solutions`` (``job``'s task on another sampling of its path) lifted
+    to ``waypoints`` (None: the full path) and solved warm, as `lifted_tasks` solves them."""
     warm = search.profile.warmed().capped(max_iter).solved_by(linear_solver)
     if mu_init is not None:
         warm = warm.with_options(**{"ipopt.mu_init": mu_init})
@@ -256,7 +256,7 @@ def plan(jobs, search):
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
                for task in lifted_tasks(jobs, candidates, search.refine, numbered_stage("refine", i), None, search,
                                         mu_init=refine_mu)]
-    if search.refine_from_coarse:  # each screened candidate refined again from its coarse optimum
+    if search.refine_from_coarse:  # each refined candidate refined again from its coarse optimum
         stage = numbered_stage("refine", len(search.refine_mu_init))
         for k in screened:
             chosen = [candidates[k][i][1] for i in picked(candidates[k], search.refine, search)]
