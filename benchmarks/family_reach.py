@@ -14,7 +14,9 @@ optimum's design (its solution file) and prints:
   coarse optimum), ``not screened``, ``screened, not landed`` (no family screen within 1.10x), ``lost in the
   refine`` (a family screen within 1.10x, the answer above it) or ``reached`` (the answer within 1.10x).
 
-Nothing is solved. The length test suits a task whose near-best designs are one arm (the circle with a keep-out
+Nothing is solved. A run's search is read from its config.yaml with this checkout's presets, so a run made by a
+checkout whose preset numbers its starts otherwise (another leader width) gets wrong start kinds; its verdict does
+not depend on them. The length test suits a task whose near-best designs are one arm (the circle with a keep-out
 zone); on the main job designs within 1.10x of the best known have other lengths too (20 of 20 runs reach 1.10x
 with 7 family optima among 17,600), and under a physical stiffness model many designs share the lengths.
 
