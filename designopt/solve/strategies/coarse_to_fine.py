@@ -253,14 +253,13 @@ def plan(jobs, search):
                                           **how)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
-    refines = [task for i, refine_mu in enumerate(search.refine_mu_init)
-               for task in lifted_tasks(jobs, candidates, search.refine, numbered_stage("refine", i), None, search,
-                                        mu_init=refine_mu)]
+    chosen = [[done[i][1] for i in picked(done, search.refine, search)] for done in candidates]
+    refines = [task for i, refine_mu in enumerate(search.refine_mu_init) for job, sols in zip(jobs, chosen, strict=True)
+               for task in lifted(job, sols, numbered_stage("refine", i), None, search, mu_init=refine_mu)]
     if search.refine_from_coarse:  # each refined candidate refined again from its coarse optimum
         stage = numbered_stage("refine", len(search.refine_mu_init))
         for k in screened:
-            chosen = [candidates[k][i][1] for i in picked(candidates[k], search.refine, search)]
-            refines += lifted(jobs[k], coarse_optima(explored[k], chosen), stage, None, search)
+            refines += lifted(jobs[k], coarse_optima(explored[k], chosen[k]), stage, None, search)
     final = by_job(jobs, (yield refines))
     return [Searched(job, e, f) for job, e, f in zip(jobs, explored, final, strict=True)]
 
