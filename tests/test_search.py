@@ -359,6 +359,15 @@ def _optimum(problem, cost: float, pattern: tuple[int, ...], shift: float):
                            raw=SimpleNamespace(q_d=q))
 
 
+def _numbered_optima(problem, costs, pattern: tuple[int, ...], numbers) -> list:
+    """`_optimum` stand-ins at these design costs (link 2 moved 0.1 m further each, so all distinct), each with the
+    start number of the task it answers."""
+    out = [_optimum(problem, cost, pattern, 0.1 * k) for k, cost in enumerate(costs)]
+    for sol, number in zip(out, numbers, strict=True):
+        sol.raw.seed = number
+    return out
+
+
 def test_the_second_rounds_leaders_are_capped_per_form():
     """``per_form``: the distinct optima in order of cost, at most that many of one form before those of other
     forms, then the rest by cost; None, or a design space without form joints: by cost alone. The second round
@@ -871,10 +880,7 @@ def test_the_prescreen_adds_the_best_of_the_next_coarse_optima_on_more_waypoints
     job = Job("", problem)
 
     def optima(costs, seeds):
-        out = [_optimum(problem, cost, a, 0.1 * k) for k, cost in enumerate(costs)]
-        for sol, seed in zip(out, seeds, strict=True):
-            sol.raw.seed = seed
-        return out
+        return _numbered_optima(problem, costs, a, seeds)
 
     def explored(search):
         plan = coarse_to_fine.plan([job], search)
@@ -920,10 +926,7 @@ def test_refine_from_coarse_refines_each_refined_candidate_again_from_its_coarse
     job = Job("", problem)
 
     def optima(costs, seeds):
-        out = [_optimum(problem, cost, a, 0.1 * k) for k, cost in enumerate(costs)]
-        for sol, seed in zip(out, seeds, strict=True):
-            sol.raw.seed = seed
-        return out
+        return _numbered_optima(problem, costs, a, seeds)
 
     def refines(search):
         plan = coarse_to_fine.plan([job], search)
