@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from replay_stages import answer
 
 from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
@@ -79,17 +80,18 @@ def run_rows(run: Path, reference: dict, within: float) -> tuple[pd.DataFrame, d
     kind = summary["stage"].astype(str).map(stage_kind)
     tracks = summary["tracks"].astype(bool)
     explored = summary[kind == "explore"]
-    family = [bool(ok) and np.abs(lengths(json.loads((run / f).read_text())["design_joints"], names) - best).max()
-              <= within for f, ok in zip(explored["solution_file"], explored["tracks"].astype(bool), strict=True)]
+    ok = tracks[kind == "explore"]
+    family = [bool(o) and np.abs(lengths(json.loads((run / f).read_text())["design_joints"], names) - best).max()
+              <= within for f, o in zip(explored["solution_file"], ok, strict=True)]
     rows = pd.DataFrame({"run": run.name, "kind": [start_kind(search, int(s)) for s in explored["seed"]],
                          "family": family, "seed": explored["seed"].to_numpy(),
-                         "cost": explored["design_cost"].to_numpy() / known, "tracks": explored["tracks"].astype(bool)})
+                         "cost": explored["design_cost"].to_numpy() / known, "tracks": ok.to_numpy()})
     ranked = rows[rows["tracks"]].sort_values("cost", kind="stable").reset_index(drop=True)
     fam = ranked[ranked["family"]]
     screens = summary[(kind == "screen") & tracks & summary["seed"].isin(fam["seed"])]
     screened = screens["design_cost"].min() / known if len(screens) else np.nan
-    answer = summary[kind.isin(["refine", "reflect"]) & tracks]["design_cost"].min() / known
-    if answer <= WITHIN:
+    best_cost = answer(run, known)
+    if best_cost <= WITHIN:
         verdict = "reached"
     elif fam.empty:
         verdict = "never reached"
@@ -102,7 +104,7 @@ def run_rows(run: Path, reference: dict, within: float) -> tuple[pd.DataFrame, d
     return rows, {"run": run.name, "family optima": len(fam),
                   "best family rank": int(fam.index[0]) if len(fam) else None,
                   "its coarse cost": round(float(fam["cost"].iloc[0]), 3) if len(fam) else None,
-                  "best family screen": round(float(screened), 3), "answer": round(float(answer), 3),
+                  "best family screen": round(float(screened), 3), "answer": round(float(best_cost), 3),
                   "where": verdict}
 
 
