@@ -144,6 +144,11 @@ def run(
         out.print(f"best: seed {b.raw.seed} ({b.raw.status}, {b.raw.iterations} iterations), design cost "
                   f"[bold]{b.metrics.design_cost:.6g}[/bold], placement xyz = ({placement[0]:.3f}, {placement[1]:.3f}, "
                   f"{placement[2]:.3f}) m")
+        if len(result.draw_bests) > 1:
+            ratios = [cost / b.metrics.design_cost for cost in result.draw_bests]
+            out.print(f"{len(ratios)} draws, each one's best / the answer: "
+                      f"{', '.join(f'{r:.3f}x' for r in ratios)} ({sum(r <= 1.01 for r in ratios)} of "
+                      f"{len(ratios)} within 1 %)")
         if urdf:
             from designopt.export import export as export_cell
             from designopt.solution import to_dict

@@ -176,3 +176,30 @@ def test_a_row_without_its_solution_file_is_dropped_on_resume(tmp_path):
     assert float(kept["c", "start", "to", "RR", 2]["design_cost"]) == 2.0  # the first row of a solve counts
     after = read_summary(run.summary)
     assert sorted(after["seed"]) == [0, 2]
+
+
+def test_a_search_of_several_draws_is_one_run_written_and_resumed(tmp_path, monkeypatch):
+    """A search of 2 draws (`Search.draws`; here the `paper` preset's 2 starts made twice): one run directory whose
+    summary holds both draws' solves (start numbers of seeds 0 and `DRAW_STRIDE`), the answer the cheaper of the
+    draws' bests, each draw's best in the log and on the terminal; resumed, nothing is solved again."""
+    from dataclasses import replace
+
+    from designopt.solve.search import DRAW_STRIDE, PRESETS
+
+    monkeypatch.setitem(PRESETS, "paper", replace(PRESETS["paper"], draws=2))
+    config = _setup(tmp_path, {"name": "job", "search": {"preset": "paper", "starts": 2}})
+    run = tmp_path / "r" / "job" / "d"
+    args = ["run", str(config), "--out", str(tmp_path / "r"), "--name", "d", "--no-figures", "--jobs", "1"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    rows = read_summary(run / "summary.csv")
+    assert sorted(rows["seed"]) == [0, 1, DRAW_STRIDE * 1000, DRAW_STRIDE * 1000 + 1]
+    tracking = rows[rows["tracks"].astype(str) == "True"]
+    bests = [tracking[(tracking["seed"] >= DRAW_STRIDE * 1000) == (k == 1)]["design_cost"].min() for k in (0, 1)]
+    assert rows.loc[rows["best"].astype(bool), "design_cost"].item() == min(bests)
+    assert f"each draw's best (seeds 0, {DRAW_STRIDE}): {bests[0]:.6g}, {bests[1]:.6g}" in (run / "run.log").read_text()
+    assert "2 draws, each one's best / the answer:" in result.output
+    again = runner.invoke(app, [*args[:-2], "--resume", "--jobs", "1"])
+    assert again.exit_code == 0, again.output
+    assert "resume: 4 solves already done, 0 to do" in (run / "run.log").read_text()
+    assert read_summary(run / "summary.csv")[KEY].equals(rows[KEY])

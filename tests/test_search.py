@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from designopt.config import load_config, parse_config
 from designopt.costs import tracking_residual
 from designopt.experiments.adapters import search_from_config, structure_config
+from designopt.experiments.run import draw_bests
 from designopt.initial_guess import (
     _moved_onto_path,
     beyond_reach,
@@ -49,8 +50,9 @@ from designopt.solve import (
     solve_one,
 )
 from designopt.solve.optima import arm_joints, cluster_designs, design_forms, form_joints
+from designopt.solve.search import DRAW_STRIDE
 from designopt.solve.starts import Rebranched, spread_branches
-from designopt.solve.strategies import coarse_to_fine, hop, reflect
+from designopt.solve.strategies import _drive, coarse_to_fine, hop, reflect
 from designopt.solve.strategies.coarse_to_fine import (
     coarse_problem,
     exploration_starts,
@@ -712,6 +714,72 @@ def test_a_later_round_on_new_joint_branches_starts_from_the_best_of_every_round
     assert not any(search.second_round(t.seed) for t in explore)
     assert "in 2 rounds, each from the best of every round before it" in search.describe()
     assert "rounds" not in replace(search, rebranch_rounds=1).describe()
+
+
+def test_draws_are_independent_searches_made_side_by_side():
+    """``draws``: the whole search made once per draw seed (`Search.draw_seeds`: the search's own first, the others
+    `DRAW_STRIDE` apart), every draw's stage given to the executor in one call and each draw's results back to it;
+    a job's solves are every draw's, in start order, and its answer the best of all. Each draw solves the starts
+    that search made alone solves."""
+    problem = problem_from_config(parse_config({}))
+    search = Search(strategy="multistart", starts=3, seed=7, draws=3, structure_neighbours=False)
+    assert search.draw_seeds == [7, 7 + DRAW_STRIDE, 7 + 2 * DRAW_STRIDE]
+    assert search.drawn() == [replace(search, seed=s, draws=1) for s in search.draw_seeds]
+
+    def cost(task):  # a stand-in solve's design cost: a function of its start alone
+        return 1.0 + (task.seed * 7919 % 1009) / 1009
+
+    calls = []
+
+    def execute(tasks):  # answers in reverse order: each draw must get its own back by key
+        calls.append(tasks)
+        return [(t, _optimum(problem, cost(t), (0, 0, 1, 0, 1), 0.0)) for t in reversed(tasks)]
+
+    (searched,) = run_search([Job("", problem)], search, execute)
+    numbers = sorted(start_number(s, i) for s in search.draw_seeds for i in range(3))
+    assert [sorted(t.seed for t in tasks) for tasks in calls] == [numbers]
+    assert [t.seed for t, _ in searched.final] == numbers
+    assert searched.best[1].metrics.design_cost == min(cost(t) for t in calls[0])
+    assert [search.draw_of(t.seed) for t, _ in searched.final] == [0, 0, 0, 1, 1, 1, 2, 2, 2]
+    assert draw_bests(searched, search) == [min(cost(t) for t, _ in searched.final[3 * k: 3 * k + 3])
+                                            for k in range(3)]
+    for one in search.drawn():
+        (alone,) = run_search([Job("", problem)], one, execute)
+        assert [t.seed for t, _ in alone.final] == [start_number(one.seed, i) for i in range(3)]
+    assert search.describe().startswith("3 independent draws (seeds 7, 1000007, 2000007), the best of them, each "
+                                        "multistart: 3 seeded starts")
+    assert not replace(search, draws=1).describe().startswith("3 independent")
+    with pytest.raises(ValueError, match="draws"):
+        Search(draws=0)
+
+
+def test_plans_of_different_lengths_are_driven_stage_by_stage_together():
+    """`strategies._drive`: each round, the current stage of every plan not yet done goes to one executor call
+    (none when no plan has a task); each plan gets back its own tasks' results, whatever order they come in, and
+    returns its answer; two plans with a solve of the same key are refused."""
+    def task(key):
+        return SimpleNamespace(key=key)
+
+    def plan(stages, answer):
+        got = []
+        for tasks in stages:
+            got.append(sorted(key for t, key in (yield tasks)))
+        return answer, got
+
+    a1, a2, b1, c2 = task("a1"), task("a2"), task("b1"), task("c2")
+    calls = []
+
+    def execute(tasks):
+        calls.append([t.key for t in tasks])
+        return [(t, t.key) for t in reversed(tasks)]
+
+    answers = _drive([plan([[a1], [a2]], "A"), plan([[b1]], "B"), plan([[], [c2]], "C"), plan([], "D")], execute)
+    assert calls == [["a1", "b1"], ["a2", "c2"]]
+    assert answers == [("A", [["a1"], ["a2"]]), ("B", [["b1"]]), ("C", [[], ["c2"]]), ("D", [])]
+    calls.clear()
+    assert _drive([plan([[]], "E")], execute) == [("E", [[]])] and calls == []
+    with pytest.raises(ValueError, match="share a solve"):
+        _drive([plan([[a1]], "A"), plan([[task("a1")]], "A again")], execute)
 
 
 def test_a_smaller_problem_of_a_batch_gets_more_exploration_starts():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,6 +33,17 @@ def searched_set(searched: Searched) -> pd.DataFrame:
     return table
 
 
+def draw_bests(searched: Searched, search: Search) -> list[float]:
+    """Each draw's best tracking full-path design cost (`Search.draws`, `Search.draw_of`; nan where a draw tracks
+    nothing): how far the draws agree tells how settled the answer is."""
+    best = [math.inf] * search.draws
+    for task, sol in searched.final:
+        if sol.metrics.tracks:
+            k = search.draw_of(task.seed)
+            best[k] = min(best[k], sol.metrics.design_cost)
+    return [cost if cost < math.inf else math.nan for cost in best]
+
+
 # a run's standard figures of its best solution (`designopt.plots.SOLUTION_FIGURES`; each drawn where it applies)
 SOLUTION_FIGURES = ("robot", "joints", "deformation", "force_deflection")
 
@@ -46,6 +58,7 @@ class RunResult:
     best: Solution | None
     summary: pd.DataFrame
     solution_set: pd.DataFrame  # the distinct local optima reached, best first (tables.solution_set)
+    draw_bests: list[float]  # each draw's best design cost (one entry unless the search has several draws)
 
 
 def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, progress: Progress | None = None,
@@ -71,6 +84,10 @@ def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, pro
                 f"optima among {len(solutions)} solves")
     else:
         run.log("no start tracks the path")
+    bests = draw_bests(searched, search)
+    if len(bests) > 1:
+        run.log(f"each draw's best (seeds {', '.join(str(s) for s in search.draw_seeds)}): "
+                f"{', '.join(f'{cost:.6g}' for cost in bests)}")
     if figures:
         explored = summary[summary["stage"] == "explore"] if searched.explore else summary
         drawings = [Drawing("designopt.plots_experiments", "search_progress_figure",
@@ -81,4 +98,4 @@ def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, pro
             drawings.append(Drawing("designopt.view", "write_view", (best, run.path / "view.html")))
         draw(drawings, jobs)
     return RunResult(run, problem, [sol for _, sol in searched.final], [task.stage for task, _ in searched.final],
-                     [sol for _, sol in searched.explore], best, summary, optima)
+                     [sol for _, sol in searched.explore], best, summary, optima, bests)

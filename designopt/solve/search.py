@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
-from designopt.initial_guess import start_index
+from designopt.initial_guess import STARTS_PER_SEED, start_index
 from designopt.problem import DesignProblem
 from designopt.solution import Solution
 from designopt.solve.observers import StalledViolation
@@ -20,6 +20,10 @@ from designopt.solve.optima import best_solution
 from designopt.solve.profile import SolverProfile
 from designopt.solve.tasks import Task
 from designopt.transcriptions import Collocation
+
+DRAW_STRIDE = 1_000_000
+"""Seeds apart of a search's independent draws (`Search.draw_seeds`): far enough that their start numbers (seed x 1000
++ index, `designopt.initial_guess.start_number`) never meet, however many indices a draw uses."""
 
 SMALL_ARM = 5
 """Moving joints below which an arm cannot track the path's 5 degrees of freedom (the tool's position and its axis's
@@ -151,6 +155,25 @@ class Search:
     hop_perturbation: float = 0.1
     hop_refine: int = 6
     small_problem_starts: float = 1.0
+    draws: int = 1
+
+    def __post_init__(self):
+        if self.draws < 1:
+            raise ValueError(f"draws must be at least 1, got {self.draws}")
+
+    @property
+    def draw_seeds(self) -> list[int]:
+        """The seeds of the ``draws`` independent draws: ``seed``, then ``seed`` + k x `DRAW_STRIDE`."""
+        return [self.seed + k * DRAW_STRIDE for k in range(self.draws)]
+
+    def drawn(self) -> list[Search]:
+        """The ``draws`` independent draws, each this search of one draw with its seed (`draw_seeds`)."""
+        return [replace(self, seed=seed, draws=1) for seed in self.draw_seeds]
+
+    def draw_of(self, number: int) -> int:
+        """Which draw (0-based, `draw_seeds`) the start numbered ``number`` belongs to; a lifted or continued solve
+        keeps its start's number, so every solve of a draw is told by it."""
+        return start_index(number, self.seed) // (DRAW_STRIDE * STARTS_PER_SEED)
 
     @property
     def rebranch_starts(self) -> int:
@@ -265,6 +288,9 @@ class Search:
 
     def describe(self) -> str:
         """The search in words."""
+        if self.draws > 1:
+            return (f"{self.draws} independent draws (seeds {', '.join(str(s) for s in self.draw_seeds)}), the best of "
+                    f"them, each {replace(self, draws=1).describe()}")
         held = "; a solve stalled on a degenerate design is finished held" if self.hold_degenerate else ""
         options = ", ".join(f"{k.removeprefix('ipopt.')} {v}" for k, v in self.profile.options)
         solver = f"; IPOPT options {options}" if options else ""  # what the profile sets beyond the backend's own
@@ -370,6 +396,18 @@ DEGENERATE_JACOBIAN = (*REGULARISED_CONSTRAINTS, ("ipopt.alpha_for_y", "min-dual
 # the paper's comparisons: every method gets the same seeded cold starts on the full path, start for start
 PAPER = Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0))
 
+# `designopt run`: 160 starts on 10 waypoints walked home, explored with the LDLᵀ; a second round on new joint branches
+# from the 8 best distinct coarse optima and the best of up to 4 forms not among them (20 drawn starts each, 30 more
+# over the branches those miss, 10 more with the design moved by 0.1); the 24 best distinct coarse optima and the best
+# 8 of the next 48 (prescreened on 20 waypoints) screened on 40 waypoints from two barriers; the best 4 refined on the
+# full path from two barriers; every refined optimum within 1.05x of the best reflected across its length bounds, then
+# the best (3 rounds at most); the same arm placed elsewhere at a cost within 0.2 % one optimum. Each setting was
+# judged on evaluation seeds never tuned on, against the preset before it (seeds better / worse, solve time):
+# docs/benchmarks.md "Search", docs/decisions.md.
+DEFAULT = Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
+                 refine_mu_init=(None, 1e-6), rebranch_new_forms=4, reflect=3, reflect_within=1.05, rebranch_extra=30,
+                 rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10, prescreen=48)
+
 PRESETS: dict[str, Search] = {
     # A structure sweep's search per structure (`designopt sweep-structures`): a quarter of the default's starts,
     # tighter caps and no second round on new joint branches; IPOPT set for degenerate Jacobians (most of a sweep's
@@ -383,18 +421,7 @@ PRESETS: dict[str, Search] = {
                     explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), small_arm_screens_once=True,
                     small_arm_perturbation=0.6,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
-    # `designopt run`: 160 starts on 10 waypoints walked home, explored with the LDLᵀ; a second round on new joint
-    # branches from the 8 best distinct coarse optima and the best of up to 4 forms not among them (20 drawn starts
-    # each, 30 more over the branches those miss, 10 more with the design moved by 0.1); the 24 best distinct coarse
-    # optima and the best 8 of the next 48 (prescreened on 20 waypoints) screened on 40 waypoints from two barriers;
-    # the best 4 refined on the full path from two barriers; every refined optimum within 1.05x of the best reflected
-    # across its length bounds, then the best (3 rounds at most); the same arm placed elsewhere at a cost within
-    # 0.2 % one optimum. Each setting was judged on evaluation seeds never tuned on, against the preset before it
-    # (seeds better / worse, solve time): docs/benchmarks.md "Search", docs/decisions.md.
-    "default": Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
-                      refine_mu_init=(None, 1e-6), rebranch_new_forms=4, reflect=3, reflect_within=1.05,
-                      rebranch_extra=30, rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10,
-                      prescreen=48),
+    "default": DEFAULT,
     "thorough": Search(starts=240, screen=24, refine=8, profile=SolverProfile(max_iter=1500)),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
