@@ -720,7 +720,7 @@ def test_draws_are_independent_searches_made_side_by_side():
     """``draws``: the whole search made once per draw seed (`Search.draw_seeds`: the search's own first, the others
     `DRAW_STRIDE` apart), every draw's stage given to the executor in one call and each draw's results back to it;
     a job's solves are every draw's, in start order, and its answer the best of all. Each draw solves the starts
-    that search made alone solves."""
+    that search made alone solves. `thorough` is the default made three times."""
     problem = problem_from_config(parse_config({}))
     search = Search(strategy="multistart", starts=3, seed=7, draws=3, structure_neighbours=False)
     assert search.draw_seeds == [7, 7 + DRAW_STRIDE, 7 + 2 * DRAW_STRIDE]
@@ -749,6 +749,7 @@ def test_draws_are_independent_searches_made_side_by_side():
     assert search.describe().startswith("3 independent draws (seeds 7, 1000007, 2000007), the best of them, each "
                                         "multistart: 3 seeded starts")
     assert not replace(search, draws=1).describe().startswith("3 independent")
+    assert PRESETS["thorough"] == replace(PRESETS["default"], draws=3)
     with pytest.raises(ValueError, match="draws"):
         Search(draws=0)
 
