@@ -14,9 +14,10 @@ optimum's design (its solution file) and prints:
   coarse optimum), ``not screened``, ``screened, not landed`` (no family screen within 1.10x), ``lost in the
   refine`` (a family screen within 1.10x, the answer above it) or ``reached`` (the answer within 1.10x).
 
-Nothing is solved. A run's search is read from its config.yaml with this checkout's presets, so a run made by a
-checkout whose preset numbers its starts otherwise (another leader width) gets wrong start kinds; its verdict does
-not depend on them. The length test suits a task whose near-best designs are one arm (the circle with a keep-out
+Nothing is solved. A run's search is its search.json (`designopt.experiments.runs.search_of_run`); a run written
+before runs had one is read from its config.yaml with this checkout's presets, so one made by a checkout whose
+preset numbered its starts otherwise (another leader width) gets wrong start kinds (its verdict does not depend on
+them). The length test suits a task whose near-best designs are one arm (the circle with a keep-out
 zone); on the main job designs within 1.10x of the best known have other lengths too (20 of 20 runs reach 1.10x
 with 7 family optima among 17,600), and under a physical stiffness model many designs share the lengths.
 
@@ -35,7 +36,7 @@ import pandas as pd
 from replay_stages import answer
 
 from designopt.config import load_config
-from designopt.experiments.adapters import search_from_config
+from designopt.experiments.runs import search_of_run
 from designopt.initial_guess import start_index
 from designopt.problem import problem_from_config
 from designopt.tables import stage_kind
@@ -46,7 +47,8 @@ WITHIN = 1.10  # an answer or screen "within" the best known: at most this facto
 
 def start_kind(search, number: int) -> str:
     """Which kind of exploration start ``number`` is: first round, or a second-round leader's drawn, extra or
-    moved start (`Search.leader_start`, `Search.more_blocks`)."""
+    moved start (`Search.leader_start`, `Search.more_blocks`), in its own draw (`Search.draws`)."""
+    search = search.drawn()[search.draw_of(number)]
     rank = search.leader_of(number)
     if rank is None:
         return "first round"
@@ -70,8 +72,7 @@ def lengths(design_joints: dict, names: list[str]) -> np.ndarray:
 def run_rows(run: Path, reference: dict, within: float) -> tuple[pd.DataFrame, dict]:
     """(one row per exploration solve: its start kind and whether it is a tracking family optimum; the run's
     verdict row)."""
-    cfg = load_config(run / "config.yaml")
-    search, chain = search_from_config(cfg), problem_from_config(cfg).chain
+    search, chain = search_of_run(run), problem_from_config(load_config(run / "config.yaml")).chain
     placement = {j.name for j in chain.placement_joints}
     names = [j.name for j in chain.design if j.kind == "length" and j.name not in placement]
     best = lengths(reference["design_joints"], names)

@@ -29,8 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from designopt.config import load_config
-from designopt.experiments.adapters import search_from_config
+from designopt.experiments.runs import search_of_run
 from designopt.tables import stage_kind
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -51,7 +50,7 @@ def later(stage: str, number: int, start: str, search) -> bool:
 def strip(run: Path, start: str) -> int:
     """Drop the rows and solution files of ``start`` and later stages; the number of rows dropped."""
     summary = pd.read_csv(run / "summary.csv")
-    drop = dropped(summary, start, search_from_config(load_config(run / "config.yaml")))
+    drop = dropped(summary, start, search_of_run(run))
     for name in summary.loc[drop, "solution_file"].dropna():
         (run / str(name)).unlink(missing_ok=True)
     summary.loc[~drop].to_csv(run / "summary.csv", index=False)
@@ -103,7 +102,7 @@ def main() -> None:
         was, now = answer(run, known), answer(copy, known)
         before.append(was)
         after.append(now)
-        search = search_from_config(load_config(copy / "config.yaml"))
+        search = search_of_run(copy)
         solved = int(dropped(pd.read_csv(copy / "summary.csv"), args.start, search).sum())
         print(f"{run}: {was:.3f} -> {now:.3f}x the best known ({n_dropped} solves dropped, {solved} solved, "
               f"{wall:.1f} s wall)", flush=True)

@@ -17,15 +17,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from designopt.config import load_config
-from designopt.experiments.adapters import search_from_config
+from designopt.experiments.runs import search_of_run
 from designopt.tables import is_coarse
 
 
 def stages(run: Path) -> pd.DataFrame:
     """A run's solves, iterations and solve time (s) per stage; ``explore2`` the exploration's second round."""
     summary = pd.read_csv(run / "summary.csv")
-    search = search_from_config(load_config(run / "config.yaml"))
+    search = search_of_run(run)
     stage = summary["stage"].astype(str).where(
         (summary["stage"] != "explore") | ~search.second_round(summary["seed"]), "explore2")
     return summary.groupby(stage).agg(solves=("iterations", "size"), iterations=("iterations", "sum"),

@@ -64,6 +64,10 @@ class RunDirectory:
     def write_config(self, text: str) -> None:
         (self.path / "config.yaml").write_text(text)
 
+    def write_search(self, text: str) -> None:
+        """The search the run makes, every setting resolved (`designopt.solve.search.search_to_dict`, as JSON)."""
+        (self.path / "search.json").write_text(text)
+
     def append_row(self, row: dict) -> None:
         """Append one row to summary.csv (header with the first row) in one O_APPEND write, then fsync,
         so a process killed at any moment leaves whole rows only. A row with a column the file does not have

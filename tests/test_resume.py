@@ -4,6 +4,7 @@ only the missing ones; a row whose solution file is gone is solved again and cou
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -181,10 +182,14 @@ def test_a_row_without_its_solution_file_is_dropped_on_resume(tmp_path):
 def test_a_search_of_several_draws_is_one_run_written_and_resumed(tmp_path, monkeypatch):
     """A search of 2 draws (`Search.draws`; here the `paper` preset's 2 starts made twice): one run directory whose
     summary holds both draws' solves (start numbers of seeds 0 and `DRAW_STRIDE`), the answer the cheaper of the
-    draws' bests, each draw's best in the log and on the terminal; resumed, nothing is solved again."""
+    draws' bests, each draw's best in the log and on the terminal, the search's every setting in search.json;
+    resumed, nothing is solved again."""
     from dataclasses import replace
 
-    from designopt.solve.search import DRAW_STRIDE, PRESETS
+    from designopt.config import load_config
+    from designopt.experiments.adapters import search_from_config
+    from designopt.experiments.runs import search_of_run
+    from designopt.solve.search import DRAW_STRIDE, PRESETS, search_from_dict
 
     monkeypatch.setitem(PRESETS, "paper", replace(PRESETS["paper"], draws=2))
     config = _setup(tmp_path, {"name": "job", "search": {"preset": "paper", "starts": 2}})
@@ -203,3 +208,8 @@ def test_a_search_of_several_draws_is_one_run_written_and_resumed(tmp_path, monk
     assert again.exit_code == 0, again.output
     assert "resume: 4 solves already done, 0 to do" in (run / "run.log").read_text()
     assert read_summary(run / "summary.csv")[KEY].equals(rows[KEY])
+    written = search_from_dict(json.loads((run / "search.json").read_text()))  # the run's search, every setting
+    assert written == search_from_config(load_config(config)) and written.draws == 2 and written.starts == 2
+    assert search_of_run(run) == written
+    (run / "search.json").unlink()  # a run of before search.json: its config's search, with today's presets
+    assert search_of_run(run) == written

@@ -750,8 +750,34 @@ def test_draws_are_independent_searches_made_side_by_side():
                                         "multistart: 3 seeded starts")
     assert not replace(search, draws=1).describe().startswith("3 independent")
     assert PRESETS["thorough"] == replace(PRESETS["default"], draws=3)
+    rounds = Search(starts=4, rebranch=2, seed=7, draws=2)  # a start's round and leader within its own draw
+    for seed in rounds.draw_seeds:
+        numbers = [start_number(seed, i) for i in (0, 3, 4, 5, 6)]
+        assert [rounds.index_in_draw(n) for n in numbers] == [0, 3, 4, 5, 6]
+        assert [bool(rounds.second_round(n)) for n in numbers] == [False, False, True, True, True]
+        assert [rounds.leader_of(n) for n in numbers] == [None, None, 0, 0, 1]
     with pytest.raises(ValueError, match="draws"):
         Search(draws=0)
+
+
+def test_a_search_written_and_read_back_is_the_same_search():
+    """search.json (`search_to_dict`, as JSON) read back (`search_from_dict`) is the search it was written from,
+    every preset and a search with every kind of field set (tuples of numbers, of names, of option pairs, None);
+    a field of another version is refused."""
+    import json
+
+    from designopt.solve.search import search_from_dict, search_to_dict
+
+    odd = Search(rebranch_shares=(3, 2), screen_mu_init=(None, 1e-6), screen_linear_solver=("ldl", "mumps"),
+                 same_arm_cost=None, draws=2, profile=SolverProfile(observers=("above_bound",), options=(
+                     ("ipopt.mu_init", 1e-6), ("ipopt.alpha_for_y", "min-dual-infeas"))))
+    for search in [*PRESETS.values(), odd]:
+        back = search_from_dict(json.loads(json.dumps(search_to_dict(search))))
+        assert back == search and back.describe() == search.describe()
+    with pytest.raises(ValueError, match="Search has no field starts_per_leader"):
+        search_from_dict({**search_to_dict(odd), "starts_per_leader": 3})
+    with pytest.raises(ValueError, match="SolverProfile has no field tol"):
+        search_from_dict({**search_to_dict(odd), "profile": {"tol": 1e-8}})
 
 
 def test_plans_of_different_lengths_are_driven_stage_by_stage_together():

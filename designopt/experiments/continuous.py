@@ -18,7 +18,7 @@ import pandas as pd
 
 from designopt.config import Config, dump_config
 from designopt.experiments.adapters import CASES, case_config, search_from_config
-from designopt.experiments.runs import Executor, Progress
+from designopt.experiments.runs import Executor, Progress, record_search
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import write_solution
@@ -48,6 +48,7 @@ def run_continuous(cfg: Config, out_root: Path, run_name: str | None = None, pro
         work += [Job(case, problem, transcription_named(method)) for method in methods]
     run = RunDirectory.create(out_root, experiment, run_name, resume)  # only once the input is known good
     run.write_config(dump_config(cfg))
+    record_search(run, search)
     run.log(f"start continuous: {len(cases)} cases x {len(methods)} methods, search {search.describe()}")
     searched = run_search(work, search, Executor(run, experiment, jobs, resume, progress))
     best_pairs = {(s.job.case, s.job.transcription.name): s.best for s in searched}

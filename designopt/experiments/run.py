@@ -10,7 +10,7 @@ import pandas as pd
 
 from designopt.config import Config, dump_config
 from designopt.experiments.adapters import search_from_config
-from designopt.experiments.runs import Drawing, Executor, Progress, draw
+from designopt.experiments.runs import Drawing, Executor, Progress, draw, record_search
 from designopt.problem import DesignProblem, problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, write_solution
@@ -70,6 +70,7 @@ def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, pro
     search = search or search_from_config(cfg)
     run = RunDirectory.create(out_root, cfg.name, run_name, resume)
     run.write_config(dump_config(cfg))
+    record_search(run, search)
     run.log(f"start {cfg.name}: structure {problem.chain.structure}, {problem.chain.n_design} design joints, "
             f"{problem.toolpath.n} waypoints, search {search.describe()}")
     (searched,) = run_search([Job("", problem)], search, Executor(run, cfg.name, jobs, resume, progress))

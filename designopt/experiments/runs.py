@@ -9,11 +9,16 @@ loads the tasks whose row and file exist instead of solving them.
 from __future__ import annotations
 
 import importlib
+import json
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Protocol
 
+from designopt.config import load_config
+from designopt.experiments.adapters import search_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, SolutionLoadError, read_solution_for, write_solution
+from designopt.solve.search import Search, search_from_dict, search_to_dict
 from designopt.solve.tasks import Task, fan_out
 
 
@@ -61,6 +66,20 @@ def draw(drawings: list[Drawing], jobs: int | None) -> None:
     from joblib import Parallel, delayed, effective_n_jobs
 
     Parallel(n_jobs=min(len(drawings), effective_n_jobs(jobs)), backend="loky")(delayed(d)() for d in drawings)
+
+
+def record_search(run: RunDirectory, search: Search) -> None:
+    """Write the run's search.json: every setting of the search it makes (a preset's name alone says less once the
+    preset changes)."""
+    run.write_search(json.dumps(search_to_dict(search), indent=1) + "\n")
+
+
+def search_of_run(path: Path) -> Search:
+    """The search a run directory's solves were made by: its search.json (`record_search`), or, for a run written
+    before runs had one, its config's search with this checkout's presets (`adapters.search_from_config`)."""
+    if (path / "search.json").is_file():
+        return search_from_dict(json.loads((path / "search.json").read_text()))
+    return search_from_config(load_config(path / "config.yaml"))
 
 
 def record(run: RunDirectory, task: Task, sol: Solution, experiment: str) -> None:

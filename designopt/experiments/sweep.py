@@ -18,7 +18,7 @@ import pandas as pd
 
 from designopt.config import Config, dump_config
 from designopt.experiments.adapters import enumerate_structures, search_from_config, structure_config
-from designopt.experiments.runs import Executor, Progress
+from designopt.experiments.runs import Executor, Progress, record_search
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solve import Job, Search, run_search
@@ -81,6 +81,7 @@ def run_sweep(cfg: Config, out_root: Path, run_name: str | None, min_dof: int = 
     search = search or search_from_config(cfg)
     run = RunDirectory.create(out_root, cfg.name, run_name, resume)
     run.write_config(dump_config(cfg))
+    record_search(run, search)
     before = len(run.resume()) if resume else 0
     run.log(f"sweep {min_dof}..{max_dof} DOF: {len(structures)} structures, search {search.describe()}; "
             f"{before} solves already done")

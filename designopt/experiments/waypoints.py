@@ -14,7 +14,7 @@ import pandas as pd
 
 from designopt.config import Config, dump_config
 from designopt.experiments.adapters import case_config, search_from_config, with_waypoints
-from designopt.experiments.runs import Executor, Progress
+from designopt.experiments.runs import Executor, Progress, record_search
 from designopt.kinematics.chain import placement_pose, tool_pose
 from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
@@ -49,6 +49,7 @@ def run_waypoint_study(cfg: Config, out_root: Path, run_name: str | None = None,
     search = search or search_from_config(cfg)
     run = RunDirectory.create(out_root, "waypoints", run_name, resume)
     run.write_config(dump_config(cfg))
+    record_search(run, search)
     run.log(f"start waypoint study: N = {', '.join(map(str, waypoints))}, search {search.describe()}")
     searched = run_search([Job(f"N{n}", problem_from_config(c)) for n, c in configs.items()], search,
                           Executor(run, "waypoints", jobs, resume, progress))

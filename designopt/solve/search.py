@@ -10,7 +10,7 @@ what it returns is one `Searched` per job. `designopt.solve.strategies.run_searc
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 
 from designopt.initial_guess import STARTS_PER_SEED, start_index
 from designopt.problem import DesignProblem
@@ -170,10 +170,15 @@ class Search:
         """The ``draws`` independent draws, each this search of one draw with its seed (`draw_seeds`)."""
         return [replace(self, seed=seed, draws=1) for seed in self.draw_seeds]
 
-    def draw_of(self, number: int) -> int:
-        """Which draw (0-based, `draw_seeds`) the start numbered ``number`` belongs to; a lifted or continued solve
-        keeps its start's number, so every solve of a draw is told by it."""
+    def draw_of(self, number):
+        """Which draw (0-based, `draw_seeds`) the start numbered ``number`` (an int or an array of them) belongs to;
+        a lifted or continued solve keeps its start's number, so every solve of a draw is told by it."""
         return start_index(number, self.seed) // (DRAW_STRIDE * STARTS_PER_SEED)
+
+    def index_in_draw(self, number):
+        """The index of the start numbered ``number`` (an int or an array of them) among its own draw's starts
+        (`initial_guess.start_index` for the draw's seed; the same as for ``seed`` in a search of one draw)."""
+        return start_index(number, self.seed) % (DRAW_STRIDE * STARTS_PER_SEED)
 
     @property
     def rebranch_starts(self) -> int:
@@ -255,17 +260,17 @@ class Search:
 
     def leader_of(self, number) -> int | None:
         """The rank of the second-round leader whose block (`leader_start`) holds the exploration start numbered
-        ``number``; None for a start of the first round or past the exploration's numbers."""
-        index = start_index(number, self.seed)
+        ``number``; None for a start of the first round or past the exploration's numbers. In any draw."""
+        index = self.index_in_draw(number)
         if not self.most_starts <= index < self.last_exploration_start:  # empty without leaders
             return None
         return (index - self.most_starts) // (self.rebranch_rounds * self.leader_width)
 
     def second_round(self, number):
         """Whether the exploration start numbered ``number`` (an int or an array of them) is of the second round,
-        on a new joint branch: its index (`initial_guess.start_index`) from ``most_starts`` on
+        on a new joint branch: its index in its draw (`index_in_draw`) from ``most_starts`` on
         (`rebranched_tasks`)."""
-        return start_index(number, self.seed) >= self.most_starts
+        return self.index_in_draw(number) >= self.most_starts
 
     @property
     def screen_passes(self) -> list[tuple[float | None, str | None]]:
@@ -434,6 +439,27 @@ PRESETS: dict[str, Search] = {
     # count; in the default search it moved the answers both ways (docs/decisions.md, 2026-11-25)
     "production": replace(PAPER, starts=4, profile=replace(PAPER.profile, options=REGULARISED_CONSTRAINTS)),
 }
+
+
+def search_to_dict(search: Search) -> dict:
+    """Every field of ``search``, its profile's too, as plain values (tuples stay tuples; JSON writes them as
+    lists): what a run writes to its search.json, so that a run says the search it made after a preset changes."""
+    return asdict(search)
+
+
+def search_from_dict(data: dict) -> Search:
+    """The search a `search_to_dict` dict (or its JSON, lists for tuples) describes. Raises ValueError for a field
+    `Search` or `SolverProfile` does not have (a file of another version)."""
+    def tuples(value):
+        return tuple(tuples(v) for v in value) if isinstance(value, list | tuple) else value
+
+    for cls, given in ((Search, data), (SolverProfile, data.get("profile", {}))):
+        unknown = set(given) - {f.name for f in fields(cls)}
+        if unknown:
+            raise ValueError(f"{cls.__name__} has no field {', '.join(sorted(unknown))}")
+    values = {k: tuples(v) for k, v in data.items() if k != "profile"}
+    profile = SolverProfile(**{k: tuples(v) for k, v in data.get("profile", {}).items()})
+    return Search(**values, profile=profile)
 
 
 def preset(name: str, **overrides) -> Search:
