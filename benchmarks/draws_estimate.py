@@ -2,12 +2,13 @@
 
 A search of k draws answers the best of k independent searches, each with its own seed, so its distribution over
 seeds is that of the best of k runs of one draw. Given RUNS (run directories of one search and task on as many
-seeds, e.g. `search_seeds.py --out DIR`'s DIR/<name>/s*; a run's answer is its best.json), this prints for each k:
+seeds, e.g. `search_seeds.py --out DIR`'s DIR/<name>/s*; a run of several draws, e.g. `thorough`, gives each of its
+draws' answers, in seed order), this prints for each k:
 
 - ``every k of n``: the best of k runs drawn without replacement from the n, over all n-choose-k of them (its
   quantiles exact by order statistics: the i-th cheapest of n is the best of a k-subset in C(n - i, k - 1) of them);
-- ``disjoint k-tuples``: the best of each run of k consecutive seeds (n // k answers, none sharing a run: the sample
-  a k-draw search on those seeds' first draws would give, had its other draws those seeds).
+- ``disjoint k-tuples``: the best of each k consecutive answers (n // k of them, none sharing a draw: with runs of
+  k draws, the answers those runs gave).
 
 Each as best / median / p90 / worst of (answer / best design known), and the share within 1.10x; for the first, the
 chance that 20 seeds are all within (the share to the 20th power). Quantiles are the distribution's (the smallest
@@ -27,10 +28,24 @@ from math import comb
 from pathlib import Path
 
 import numpy as np
-from replay_stages import answer
+import pandas as pd
+
+from designopt.experiments.runs import search_of_run
+from designopt.tables import is_coarse
 
 WITHIN = 1.10
 SEEDS = 20  # an evaluation set's size (issue 25: at least 20 seeds never tuned on)
+
+
+def draw_answers(run: Path, known: float) -> list[float]:
+    """A run's answer per draw over ``known`` (one for a run of one draw): the cheapest tracking full-path solve of
+    each draw (`Search.draw_of` of its start number), what best.json holds for a run of one draw; inf for a draw
+    that tracks nothing."""
+    search = search_of_run(run)
+    summary = pd.read_csv(run / "summary.csv")
+    final = summary[~summary["stage"].map(is_coarse) & summary["tracks"].astype(str).eq("True")]
+    best = final.groupby(search.draw_of(final["seed"]))["design_cost"].min()
+    return [float(best.get(k, np.inf)) / known for k in range(search.draws)]
 
 
 def best_of_every_k(answers: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
@@ -66,9 +81,10 @@ def main() -> None:
     args = parser.parse_args()
     known = json.loads(args.reference.read_text())["metrics"]["design_cost"]
     runs = sorted(args.runs, key=lambda run: int(run.name.lstrip("s")))
-    a = np.array([answer(run, known) for run in runs])
+    a = np.array([x for run in runs for x in draw_answers(run, known)])
     n = len(a)
-    print(f"{n} runs, seeds {runs[0].name}-{runs[-1].name}; best / median / p90 / worst of answer / best known")
+    print(f"{n} draws of {len(runs)} runs, seeds {runs[0].name}-{runs[-1].name}; best / median / p90 / worst of "
+          "answer / best known")
     print(f"  1 draw: {describe(*best_of_every_k(a, 1), SEEDS)}")
     for k in args.draws:
         if not 1 < k <= n:
