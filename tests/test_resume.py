@@ -183,7 +183,7 @@ def test_a_search_of_several_draws_is_one_run_written_and_resumed(tmp_path, monk
     """A search of 2 draws (`Search.draws`; here the `paper` preset's 2 starts made twice): one run directory whose
     summary holds both draws' solves (start numbers of seeds 0 and `DRAW_STRIDE`), the answer the cheaper of the
     draws' bests, each draw's best in the log and on the terminal, the search's every setting in search.json;
-    resumed, nothing is solved again."""
+    resumed, nothing is solved again; resumed with another search (the preset changed), refused."""
     from dataclasses import replace
 
     from designopt.config import load_config
@@ -211,5 +211,9 @@ def test_a_search_of_several_draws_is_one_run_written_and_resumed(tmp_path, monk
     written = search_from_dict(json.loads((run / "search.json").read_text()))  # the run's search, every setting
     assert written == search_from_config(load_config(config)) and written.draws == 2 and written.starts == 2
     assert search_of_run(run) == written
+    monkeypatch.setitem(PRESETS, "paper", replace(PRESETS["paper"], draws=3))  # the preset changed since
+    changed = runner.invoke(app, [*args[:-2], "--resume", "--jobs", "1"])
+    assert changed.exit_code == 2 and "search.json: --resume: the run was started with another search" in changed.output
+    assert read_summary(run / "summary.csv")[KEY].equals(rows[KEY]) and search_of_run(run) == written
     (run / "search.json").unlink()  # a run of before search.json: its config's search, with today's presets
-    assert search_of_run(run) == written
+    assert search_of_run(run).draws == 3

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Protocol
 
 from designopt.config import load_config
+from designopt.errors import InputError
 from designopt.experiments.adapters import search_from_config
 from designopt.results_io import RunDirectory
 from designopt.solution import Solution, SolutionLoadError, read_solution_for, write_solution
@@ -70,7 +71,18 @@ def draw(drawings: list[Drawing], jobs: int | None) -> None:
 
 def record_search(run: RunDirectory, search: Search) -> None:
     """Write the run's search.json: every setting of the search it makes (a preset's name alone says less once the
-    preset changes)."""
+    preset changes). A run resumed with another search than it was started with is refused (its solves would be of
+    two searches): one line naming the file, exit code 2."""
+    path = run.path / "search.json"
+    if path.is_file():
+        try:
+            same = search_from_dict(json.loads(path.read_text())) == search
+        except (ValueError, TypeError):  # unreadable, or of another version
+            same = False
+        if not same:
+            raise InputError(path, "--resume", "the run was started with another search (another config, or a preset "
+                                               "that has changed since): finish it as it was started, or use another "
+                                               "--name")
     run.write_search(json.dumps(search_to_dict(search), indent=1) + "\n")
 
 
