@@ -47,8 +47,8 @@ def run_continuous(cfg: Config, out_root: Path, run_name: str | None = None, pro
         problem = problem_from_config(case_config(cfg, case))
         work += [Job(case, problem, transcription_named(method)) for method in methods]
     run = RunDirectory.create(out_root, experiment, run_name, resume)  # only once the input is known good
+    record_search(run, search)  # first: a resume with another search is refused before the run is touched
     run.write_config(dump_config(cfg))
-    record_search(run, search)
     run.log(f"start continuous: {len(cases)} cases x {len(methods)} methods, search {search.describe()}")
     searched = run_search(work, search, Executor(run, experiment, jobs, resume, progress))
     best_pairs = {(s.job.case, s.job.transcription.name): s.best for s in searched}

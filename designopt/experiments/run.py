@@ -69,8 +69,8 @@ def run_experiment(cfg: Config, out_root: Path, run_name: str | None = None, pro
     problem = problem_from_config(cfg)
     search = search or search_from_config(cfg)
     run = RunDirectory.create(out_root, cfg.name, run_name, resume)
+    record_search(run, search)  # first: a resume with another search is refused before the run is touched
     run.write_config(dump_config(cfg))
-    record_search(run, search)
     run.log(f"start {cfg.name}: structure {problem.chain.structure}, {problem.chain.n_design} design joints, "
             f"{problem.toolpath.n} waypoints, search {search.describe()}")
     (searched,) = run_search([Job("", problem)], search, Executor(run, cfg.name, jobs, resume, progress))

@@ -80,8 +80,8 @@ def run_sweep(cfg: Config, out_root: Path, run_name: str | None, min_dof: int = 
     sweep_jobs(cfg, structures[:1])  # bad input stops here, before a run directory exists
     search = search or search_from_config(cfg)
     run = RunDirectory.create(out_root, cfg.name, run_name, resume)
+    record_search(run, search)  # first: a resume with another search is refused before the run is touched
     run.write_config(dump_config(cfg))
-    record_search(run, search)
     before = len(run.resume()) if resume else 0
     run.log(f"sweep {min_dof}..{max_dof} DOF: {len(structures)} structures, search {search.describe()}; "
             f"{before} solves already done")

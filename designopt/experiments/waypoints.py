@@ -48,8 +48,8 @@ def run_waypoint_study(cfg: Config, out_root: Path, run_name: str | None = None,
     configs = {n: with_waypoints(base, n) for n in waypoints}
     search = search or search_from_config(cfg)
     run = RunDirectory.create(out_root, "waypoints", run_name, resume)
+    record_search(run, search)  # first: a resume with another search is refused before the run is touched
     run.write_config(dump_config(cfg))
-    record_search(run, search)
     run.log(f"start waypoint study: N = {', '.join(map(str, waypoints))}, search {search.describe()}")
     searched = run_search([Job(f"N{n}", problem_from_config(c)) for n, c in configs.items()], search,
                           Executor(run, "waypoints", jobs, resume, progress))
