@@ -88,7 +88,7 @@ def main() -> None:
     print(f"  1 draw: {describe(*best_of_every_k(a, 1), SEEDS)}")
     for k in args.draws:
         if not 1 < k <= n:
-            raise SystemExit(f"error: --draws {k}: needs 2 to {n} (the number of runs)")
+            raise SystemExit(f"error: --draws {k}: needs 2 to {n} (the number of draws given)")
         tuples = a[: n // k * k].reshape(-1, k).min(axis=1)
         print(f"  {k} draws, every {k} of {n}: {describe(*best_of_every_k(a, k), SEEDS)}")
         uniform = np.full(len(tuples), 1 / len(tuples))
