@@ -100,6 +100,8 @@ MUTATIONS = [
     # the search (issue 11)
     Mutation("search refines the most expensive coarse optima", "designopt/solve/optima.py",
              "for k in np.argsort(costs, kind=\"stable\"):", "for k in np.argsort(-costs, kind=\"stable\"):"),
+    Mutation("an angle's difference taken the long way round the circle", "designopt/solve/optima.py",
+             "d[..., angle] = np.minimum(turn, TWO_PI - turn)", "d[..., angle] = turn", ("tests/test_tables.py",)),
     Mutation("distinct optima: a design joins the last cluster near it, not the first", "designopt/solve/optima.py",
              "labels[i] = near[0]", "labels[i] = near[-1]", ("tests/test_tables.py",)),
     Mutation("a form keeps one leader more than rebranch_per_form allows", "designopt/solve/optima.py",

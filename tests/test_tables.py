@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designopt.solve import cluster_designs, design_distance
+from designopt.solve.optima import design_distances
 from designopt.tables import best_so_far, is_coarse, structure_table
 
 
@@ -15,6 +16,21 @@ def test_design_distance_wraps_angles():
     angle = np.array([False, True])
     assert abs(design_distance([0.1, np.pi - 0.01], [0.1, -np.pi + 0.01], angle) - 0.02) < 1e-12
     assert abs(design_distance([0.3, 0.0], [0.1, 0.0], angle) - 0.2) < 1e-12
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 6), st.integers(0, 2**32 - 1))
+def test_design_distances_are_the_angle_between_unit_vectors(n_design, seed):
+    """An angle's difference is the angle between the two directions (atan2 of the cross and dot products of their
+    unit vectors: in [0, pi]) whatever turns either carries; a length's, the absolute difference."""
+    rng = np.random.default_rng(seed)
+    angle = rng.random(n_design) < 0.5
+    a = rng.uniform(-3, 3, n_design) + 2 * np.pi * rng.integers(-3, 4, n_design) * angle
+    b = rng.uniform(-3, 3, (5, n_design)) + 2 * np.pi * rng.integers(-3, 4, (5, n_design)) * angle
+    between = np.abs(np.arctan2(np.sin(a) * np.cos(b) - np.cos(a) * np.sin(b), np.cos(a) * np.cos(b)
+                                + np.sin(a) * np.sin(b)))
+    expected = np.max(np.where(angle, between, np.abs(a - b)), axis=-1)
+    assert np.allclose(design_distances(a, b, angle), expected, rtol=0, atol=1e-12)
 
 
 def test_cluster_designs_finds_the_distinct_optima():
