@@ -158,11 +158,13 @@ def projected(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations
     above ``tol`` where the step was beyond reach."""
     Q = np.array(Q, dtype=float)
     everywhere = np.arange(len(Q))
-    Q, r = _moved_onto_path(problem, q_d, Q, everywhere, iterations)
+    chain = pickle.dumps(problem.chain)
+    Q, r = _moved_onto_path(problem, q_d, Q, everywhere, iterations, chain)
     for k in range(1, len(Q)):
         jumped = bool(beyond_reach(problem, Q[k - 1 : k + 1], k - 1)[0])
         if np.linalg.norm(r[k]) > tol or jumped:
-            walked, r_walked = _moved_onto_path(problem, q_d, Q[k - 1 : k], everywhere[k : k + 1], iterations)
+            walked, r_walked = _moved_onto_path(problem, q_d, Q[k - 1 : k], everywhere[k : k + 1], iterations,
+                                                chain)
             nearer = r_walked[0] @ r_walked[0] < r[k] @ r[k]
             reached = np.linalg.norm(r_walked[0]) <= tol and not beyond_reach(problem, np.vstack([Q[k - 1], walked]),
                                                                              k - 1)[0]
@@ -178,11 +180,14 @@ def beyond_reach(problem: DesignProblem, Q: np.ndarray, first: int = 0) -> np.nd
     return np.any(np.abs(np.diff(Q, axis=0)) > problem.max_steps[first : first + len(Q) - 1], axis=1)
 
 
-def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks: np.ndarray, iterations: int):
+def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks: np.ndarray, iterations: int,
+                     chain: bytes | None = None):
     """(Q, residuals): damped least squares at waypoints ``ks`` from the rows of ``Q`` (len(ks) x n_moving), each
-    waypoint with its own damping; a step that does not lower a waypoint's residual is not taken."""
+    waypoint with its own damping; a step that does not lower a waypoint's residual is not taken. ``chain``: the
+    problem's chain pickled, the key of its residual functions (None: pickled here)."""
     n, n_m = Q.shape
-    fn = point_residual(problem).fn.map(n)  # r and dr/dq only: the design is held
+    # r and dr/dq only: the design is held
+    fn = _mapped_point_residual(pickle.dumps(problem.chain) if chain is None else chain, n)
     S = problem.toolpath.points_W[ks].T
     D = np.tile(np.asarray(q_d, float)[:, None], (1, n))
     lo = np.array([j.lower for j in problem.chain.moving])
@@ -190,7 +195,7 @@ def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks:
 
     def evaluate(Q):  # residuals (n x 6) and Jacobians (n x 6 x n_m)
         r, J_q = fn(Q.T, D, S)
-        return np.array(r).T, np.array(J_q).reshape(6, n, n_m).transpose(1, 0, 2)
+        return r.T, J_q.reshape(6, n, n_m).transpose(1, 0, 2)
 
     Q = np.array(Q, dtype=float)
     r, J = evaluate(Q)
@@ -310,6 +315,15 @@ def _point_residual(payload: bytes):
     r, J_q, _ = full(*args)  # its graph inlined; the design Jacobian, which nothing reads, dropped
     # dense, so that a joint no row depends on (a last joint turning about the tool axis) is a column of zeros
     return _InPlace(ca.Function("tracking_residual_q", args, [ca.densify(r), ca.densify(J_q)]))
+
+
+@functools.lru_cache(maxsize=64)
+def _mapped_point_residual(payload: bytes, n: int):
+    """`point_residual`'s function mapped over ``n`` points, evaluated in place (`_InPlace`): (q (n_moving x n), q_d
+    (n_design x n), s_W (3 x n)) -> (r (6 x n), dr/dq (6 x n n_moving)). Built once per chain and count in a
+    process: a lift walks 40-80 waypoints together, then each one it walks again alone, and a mapped function
+    created and called through CasADi's DMs each time cost a lift about as much as its IK."""
+    return _InPlace(_point_residual(payload).fn.map(n))
 
 
 STARTS_PER_SEED = 1000  # a start's number: seed * STARTS_PER_SEED + index
