@@ -394,6 +394,49 @@ def first_configuration(problem: DesignProblem, index: int, seed: int, scale: fl
     return ik_trajectory(problem, q_d, q0, home_pull=HOME_PULL if mode == "home" else 0.0, waypoints=1)[0]
 
 
+def first_configurations(problem: DesignProblem, starts: list[tuple[int, int, float, np.ndarray | None, str]],
+                         mode: str = "ik") -> np.ndarray:
+    """`first_configuration` of many starts of one problem, one row each, to the bit: ``starts`` holds each one's
+    (index, seed, scale, design, spread). The walks to the first waypoint go in lockstep, each start with its own
+    damping and stopping where it alone would (the first waypoint is walked unpulled in every ``mode``), their
+    residuals evaluated by one mapped function; numpy's batched solves and products give each start the numbers its
+    own walk gets. A second round's leader has 60-90 such starts, walked between two stages while the workers wait."""
+    drawn = [_drawn(problem, index, seed, scale, design, spread) for index, seed, scale, design, spread in starts]
+    if mode == "constant" or not drawn:
+        return np.array([q0 for _, q0 in drawn], dtype=float).reshape(len(drawn), problem.chain.n_moving)
+    m, n = len(drawn), problem.chain.n_moving
+    fn = _mapped_point_residual(pickle.dumps(problem.chain), m)
+    D = np.array([q_d for q_d, _ in drawn], dtype=float).T.reshape(problem.chain.n_design, m)
+    S = np.tile(np.asarray(problem.toolpath.points_W[0], float)[:, None], (1, m))
+    lo = np.array([j.lower for j in problem.chain.moving])
+    hi = np.array([j.upper for j in problem.chain.moving])
+
+    def evaluate(Q):  # each start's residual (6,) and Jacobian (6 x n), contiguous as its own walk's are
+        r, J_q = fn(Q.T, D, S)
+        return np.ascontiguousarray(r.T), np.ascontiguousarray(J_q.reshape(6, m, n).transpose(1, 0, 2))
+
+    Q = np.array([q0 for _, q0 in drawn], dtype=float)
+    r, J = evaluate(Q)
+    damping = np.full(m, 1e-2)
+    walking = np.ones(m, dtype=bool)
+    eye = np.eye(n)
+    for _ in range(30 + (POLISH if mode == "home" else 0)):  # `ik_trajectory`'s iterations at its first waypoint
+        JT = J.transpose(0, 2, 1)
+        step = np.linalg.solve(JT @ J + damping[:, None, None] * eye, -(JT @ r[:, :, None]))[:, :, 0]
+        trial = np.clip(Q + step + 0.0, lo, hi)
+        r_new, J_new = evaluate(trial)
+        for i in np.flatnonzero(walking):
+            if r_new[i] @ r_new[i] < r[i] @ r[i]:
+                Q[i], r[i], J[i], damping[i] = trial[i], r_new[i], J_new[i], max(damping[i] / 3, 1e-6)
+            else:
+                damping[i] = damping[i] * 5
+            if r[i] @ r[i] < 1e-14:
+                walking[i] = False
+        if not walking.any():
+            break
+    return Q
+
+
 def design_from(problem: DesignProblem, other: DesignProblem, q_d_other: np.ndarray) -> np.ndarray:
     """``problem``'s design joints with the values another problem's design ``q_d_other`` gives the joints of the
     same name (e.g. a neighbouring structure's placement and link lengths); the others keep their configured

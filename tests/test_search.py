@@ -51,7 +51,7 @@ from designopt.solve import (
 )
 from designopt.solve.optima import arm_joints, cluster_designs, design_forms, form_joints
 from designopt.solve.search import DRAW_STRIDE
-from designopt.solve.starts import Rebranched, spread_branches
+from designopt.solve.starts import Rebranched, first_configurations_of, spread_branches
 from designopt.solve.strategies import _drive, coarse_to_fine, hop, reflect
 from designopt.solve.strategies.coarse_to_fine import (
     coarse_problem,
@@ -515,6 +515,21 @@ def test_a_walks_first_configuration_is_its_first_row_to_the_bit():
             seeded = initial_guess(problem, index, 3, 0.3, mode)
             assert np.array_equal(first_configuration(problem, index, 3, 0.3, mode), seeded.Q[0])
     assert not np.array_equal(first_configuration(problem, 1, 3, 0.3), first_configuration(problem, 2, 3, 0.3))
+
+
+def test_starts_walked_together_reach_what_each_walk_alone_does():
+    """`first_configurations_of` walks a leader's starts to the first waypoint in lockstep: each row equals that
+    start's own walk to the bit (independent truth: `Rebranched.first_configuration`, one start at a time), moved
+    designs and starts that converge at different iterations among them, in every init."""
+    problem = coarse_problem(problem_from_config(parse_config({})), 6)
+    leader = SimpleNamespace(raw=SimpleNamespace(q_d=problem.chain.design_values + 0.05))
+    for mode in ("ik", "home", "constant"):
+        starts = [Rebranched(leader, 3, index, mode, 0.1 if index % 3 == 2 else 0.0) for index in range(12)]
+        together = first_configurations_of(problem, starts)
+        alone = np.array([start.first_configuration(problem) for start in starts])
+        assert together.shape == (12, problem.chain.n_moving)
+        assert np.array_equal(together, alone)
+    assert first_configurations_of(problem, []).shape == (0, problem.chain.n_moving)
 
 
 def test_branches_spread_by_farthest_points_one_from_each_cluster():

@@ -17,6 +17,7 @@ import numpy as np
 from designopt.initial_guess import (
     design_named,
     first_configuration,
+    first_configurations,
     initial_guess,
     perturbed_design,
     projected,
@@ -104,6 +105,15 @@ class Rebranched(Numbered):
         """Where this start's walk reaches the path's first waypoint (`guess`'s first row, for a fraction of its cost:
         `initial_guess.first_configuration`; a seventh on the main job's 10 waypoints)."""
         return first_configuration(problem, self.index, self.seed, 0.0, self.init, self.design(problem), "box")
+
+
+def first_configurations_of(problem: DesignProblem, starts: list[Rebranched]) -> np.ndarray:
+    """Each start's `Rebranched.first_configuration` (one row each), to the bit, the walks of one init made
+    together (`initial_guess.first_configurations`)."""
+    if len({start.init for start in starts}) > 1:
+        return np.array([start.first_configuration(problem) for start in starts])
+    drawn = [(start.index, start.seed, 0.0, start.design(problem), "box") for start in starts]
+    return first_configurations(problem, drawn, starts[0].init if starts else "ik")
 
 
 def spread_branches(configurations: np.ndarray, count: int, angle: np.ndarray, kept: int = 1) -> list[int]:

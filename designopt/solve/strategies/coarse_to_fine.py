@@ -45,7 +45,7 @@ import numpy as np
 from designopt.problem import DesignProblem
 from designopt.solve.optima import best_solution, distinct_best
 from designopt.solve.search import Searched, by_job
-from designopt.solve.starts import Lifted, Rebranched, spread_branches
+from designopt.solve.starts import Lifted, Rebranched, first_configurations_of, spread_branches
 from designopt.solve.strategies.steps import numbered_stage, seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
@@ -189,7 +189,7 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
             pool = [Rebranched(sol, search.seed, j, search.init) for j in drawn]
             angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
             if search.rebranch_pool > 1 or any(count > 0 for count, _, _ in search.more_blocks):
-                firsts = np.array([start.first_configuration(first.problem) for start in pool])
+                firsts = first_configurations_of(first.problem, pool)
             if search.rebranch_pool > 1:
                 chosen = sorted(spread_branches(firsts, n, angle))
                 pool, firsts = [pool[j] for j in chosen], firsts[chosen]
@@ -206,7 +206,7 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
 def _spread_more(pool, firsts, more, count: int, angle, problem) -> tuple[list, np.ndarray]:
     """``pool`` (its walks' first configurations ``firsts``) and ``count`` of the starts ``more`` spread over the
     branches it misses (`spread_branches`, ``pool`` kept), in index order; and the first configurations of all."""
-    firsts = np.vstack([firsts, [start.first_configuration(problem) for start in more]])
+    firsts = np.vstack([firsts, first_configurations_of(problem, more)])
     taken = sorted(spread_branches(firsts, len(pool) + count, angle, kept=len(pool))[len(pool):])
     return pool + [more[j - len(pool)] for j in taken], firsts[list(range(len(pool))) + taken]
 
