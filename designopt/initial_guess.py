@@ -76,9 +76,10 @@ def random_configuration(problem: DesignProblem, rng: np.random.Generator, half_
 HOME_PULL = 0.5  # share of the self-motion step towards the home posture an IK iteration of ``init: home`` takes
 HOME_STEP = 0.5  # largest self-motion step of one IK iteration [rad or m, the joints' own units]
 POLISH = 10  # damped least-squares iterations without the pull that finish a waypoint's IK
+IK_ITERATIONS = 30  # `ik_trajectory`'s damped least-squares iterations at its first waypoint (a third at the others)
 
 
-def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, iterations: int = 30,
+def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, iterations: int = IK_ITERATIONS,
                   home_pull: float = 0.0, waypoints: int | None = None) -> np.ndarray:
     """Damped least-squares IK along the path from ``q0``, each waypoint starting from the previous solution; with
     ``home_pull`` > 0 (`HOME_PULL` for ``init: home``), the redundancy resolved towards the first waypoint's
@@ -420,7 +421,7 @@ def first_configurations(problem: DesignProblem, starts: list[tuple[int, int, fl
     damping = np.full(m, 1e-2)
     walking = np.ones(m, dtype=bool)
     eye = np.eye(n)
-    for _ in range(30 + (POLISH if mode == "home" else 0)):  # `ik_trajectory`'s iterations at its first waypoint
+    for _ in range(IK_ITERATIONS + (POLISH if mode == "home" else 0)):  # as `ik_trajectory` at its first waypoint
         JT = J.transpose(0, 2, 1)
         step = np.linalg.solve(JT @ J + damping[:, None, None] * eye, -(JT @ r[:, :, None]))[:, :, 0]
         trial = np.clip(Q + step + 0.0, lo, hi)
