@@ -73,6 +73,12 @@ def random_configuration(problem: DesignProblem, rng: np.random.Generator, half_
     return np.array(out)
 
 
+def moving_bounds(problem: DesignProblem) -> tuple[np.ndarray, np.ndarray]:
+    """The moving joints' lower and upper bounds (rad for revolute joints, m for prismatic ones), where an IK walk
+    clips its steps."""
+    return np.array([j.lower for j in problem.chain.moving]), np.array([j.upper for j in problem.chain.moving])
+
+
 HOME_PULL = 0.5  # share of the self-motion step towards the home posture an IK iteration of ``init: home`` takes
 HOME_STEP = 0.5  # largest self-motion step of one IK iteration [rad or m, the joints' own units]
 POLISH = 10  # damped least-squares iterations without the pull that finish a waypoint's IK
@@ -115,8 +121,7 @@ def ik_trajectory(problem: DesignProblem, q_d: np.ndarray, q0: np.ndarray, itera
         size = np.linalg.norm(step)
         return step * min(1.0, HOME_STEP / size) if size > 0 else step
 
-    lo = np.array([j.lower for j in problem.chain.moving])
-    hi = np.array([j.upper for j in problem.chain.moving])
+    lo, hi = moving_bounds(problem)
     Q = np.empty((problem.toolpath.n if waypoints is None else min(waypoints, problem.toolpath.n), len(q0)))
     q = np.array(q0, dtype=float)
     home = None  # the first waypoint's own configuration, once walked to (the first waypoint is walked unpulled)
@@ -191,8 +196,7 @@ def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks:
     fn = _mapped_point_residual(pickle.dumps(problem.chain) if chain is None else chain, n)
     S = problem.toolpath.points_W[ks].T
     D = np.tile(np.asarray(q_d, float)[:, None], (1, n))
-    lo = np.array([j.lower for j in problem.chain.moving])
-    hi = np.array([j.upper for j in problem.chain.moving])
+    lo, hi = moving_bounds(problem)
 
     def evaluate(Q):  # residuals (n x 6) and Jacobians (n x 6 x n_m)
         r, J_q = fn(Q.T, D, S)
@@ -409,8 +413,7 @@ def first_configurations(problem: DesignProblem, starts: list[tuple[int, int, fl
     fn = _mapped_point_residual(pickle.dumps(problem.chain), m)
     D = np.array([q_d for q_d, _ in drawn], dtype=float).T.reshape(problem.chain.n_design, m)
     S = np.tile(np.asarray(problem.toolpath.points_W[0], float)[:, None], (1, m))
-    lo = np.array([j.lower for j in problem.chain.moving])
-    hi = np.array([j.upper for j in problem.chain.moving])
+    lo, hi = moving_bounds(problem)
 
     def evaluate(Q):  # each start's residual (6,) and Jacobian (6 x n), contiguous as its own walk's are
         r, J_q = fn(Q.T, D, S)
