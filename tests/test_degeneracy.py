@@ -14,6 +14,7 @@ from conftest import gantry_config, solve
 
 from designopt.config import parse_config
 from designopt.evaluation import evaluate
+from designopt.initial_guess import initial_guess
 from designopt.kinematics.chain import tool_pose
 from designopt.problem import problem_from_config
 from designopt.solve import Search
@@ -124,3 +125,57 @@ def test_a_solve_stalled_on_a_planar_design_is_finished_with_its_twists_held(hol
 def test_the_search_says_whether_stalled_solves_are_held():
     assert "finished held" in Search(hold_degenerate=True).describe()
     assert "held" not in Search(hold_degenerate=False).describe()
+
+
+def test_held_problems_share_one_nlp_and_solve_as_if_built_alone():
+    """The planar arm held with its twists at 0 / -pi and at 0 / +pi: one NLP built (as `shared_shape`, held at 0),
+    each solved with its own bounds, and each solve is the one an NLP built from that held problem alone gives, to
+    the bit. A problem whose rows imposed once change when held at 0 is its own shape."""
+    from designopt.solve import local
+    from designopt.solve.backends import backend_named
+    from designopt.solve.profile import SolverProfile
+    from designopt.transcriptions.collocation import Collocation
+    from designopt.transcriptions.degeneracy import shared_shape
+
+    _, problem = design_only(waypoints=8)
+    q_d = planar_design(problem)
+    minus, at_minus = held_at_multiples_of_pi(problem, q_d)
+    flipped = np.where(np.isclose(at_minus, -np.pi), np.pi, at_minus)
+    plus, at_plus = held_at_multiples_of_pi(problem, flipped)
+    assert not np.array_equal(at_minus, at_plus)
+    shape = shared_shape(minus)
+    assert shape is not minus and shared_shape(plus) == shape and shared_shape(shape) is shape
+    assert all(j.lower == j.upper == 0.0 for j in shape.chain.design if j.name.endswith(".alpha"))
+    assert shared_shape(problem) is problem  # nothing held
+    # the first twist held at pi/2: fewer rows imposed once than the four of every twist at 0 or pi
+    first = next(i for i, j in enumerate(minus.chain.joints) if j.name.endswith(".alpha"))
+    tilted = list(minus.chain.joints)
+    tilted[first] = replace(tilted[first], value=np.pi / 2, lower=np.pi / 2, upper=np.pi / 2)
+    tilted = replace(minus, chain=replace(minus.chain, joints=tuple(tilted)))
+    assert list(q_independent_rows(minus)) == [2, 3, 4, 5] != list(q_independent_rows(tilted))
+    assert shared_shape(tilted) is tilted
+
+    profile = SolverProfile(max_iter=40, compile="none")
+    transcription = Collocation()
+    local._built.cache_clear()
+    local._prepared.cache_clear()
+    builds = []
+    for held, at in ((minus, at_minus), (plus, at_plus)):
+        built, solver, spent = local.prepared(held, transcription, profile)
+        builds.append(spent)
+        guess = built.pack(initial_guess(held, 0, 0, 0.3, "ik"))
+        outcome = solver.solve(guess)
+        alone = transcription.build(held)  # the NLP of this held problem, built from it
+        own = backend_named(profile.backend).prepare(alone.nlp, profile).solve(alone.pack(initial_guess(held, 0, 0,
+                                                                                                       0.3, "ik")))
+        assert outcome.iterations == own.iterations > 0 and outcome.status == own.status
+        np.testing.assert_array_equal(outcome.x, own.x)
+        np.testing.assert_array_equal(outcome.x[: len(at)][twists(held)], at[twists(held)])  # held where it was
+    assert builds[0] > 0 and builds[1] == 0.0  # the second held problem built nothing
+
+    # a bounded solver keeps the NLP's fixed joints: it cannot fix one more
+    _, solver, _ = local.prepared(minus, transcription, profile)
+    design = minus.chain.design
+    lower = np.array([j.lower for j in design])
+    with pytest.raises(ValueError, match="fix the design joints"):
+        solver.bounded(lower, lower)

@@ -20,6 +20,7 @@ from designopt.solve.observers import Bound
 from designopt.solve.profile import SolverProfile
 from designopt.transcriptions.base import InitialGuess, RawResult
 from designopt.transcriptions.compiled import record_work, tiered_up
+from designopt.transcriptions.degeneracy import shared_shape
 
 # IPOPT's linear algebra gains nothing from threads at this size; parallelism is across starts.
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -40,11 +41,14 @@ def _prepared(key: str, payload: bytes, profile: SolverProfile):
 
 def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
     """(built NLP, prepared solver, seconds this call spent building and preparing: 0 when both were cached).
+    A problem with held design joints is built as its `shared_shape` (held at 0) and solved with its own bounds,
+    so that the held problems of a search share one build per set of held joints.
     A cached solver whose blocks have since tiered up to -O1 (`designopt.transcriptions.compiled`; another
     process may have built them) is built again, so that a long run gains from its tier-up at once."""
-    payload = pickle.dumps((problem, transcription))
-    key = hashlib.sha256(payload).hexdigest()
     t0 = time.perf_counter()
+    shape = shared_shape(problem)
+    payload = pickle.dumps((shape, transcription))
+    key = hashlib.sha256(payload).hexdigest()
     misses = _prepared.cache_info().misses
     built, solver = _prepared(key, payload, profile)
     fresh = _prepared.cache_info().misses > misses
@@ -53,6 +57,9 @@ def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
         _prepared.cache_clear()
         built, solver = _prepared(key, payload, profile)
         fresh = True
+    if shape is not problem:
+        design = problem.chain.design
+        solver = solver.bounded([j.lower for j in design], [j.upper for j in design])
     return built, solver, (time.perf_counter() - t0) if fresh else 0.0
 
 

@@ -107,3 +107,29 @@ def held_at_multiples_of_pi(problem: DesignProblem, q_d, tol: float = 1e-3,
     if len(q_independent_rows(candidate, jacobian=jacobian)) <= before:
         return None  # e.g. a PPP gantry, whose axis rows never depended on its joints: nothing degenerates here
     return candidate, q_d
+
+
+def shared_shape(problem: DesignProblem) -> DesignProblem:
+    """The problem whose NLP a solve of ``problem`` can use: ``problem`` with each held design joint (lower ==
+    upper) held at 0 instead. A held joint stays a variable of the NLP, so where it is held changes only its bounds,
+    which a solve passes (`designopt.solve.backends.base.Prepared.bounded`), and the tracking rows imposed once
+    (`q_independent_rows`, judged at the held values). The held problems of a search's continuations (twists held at
+    0 or +-pi) then share one NLP per set of held joints instead of one each. ``problem`` itself when no design joint
+    is held, when every held one is at 0 already, or when the rows imposed once at 0 are not those at its values."""
+    joints = problem.chain.joints
+    held = [i for i, j in enumerate(joints) if j.role is Role.DESIGN and j.lower == j.upper]
+    if all(_plus_zero(joints[i].value) and _plus_zero(joints[i].lower) for i in held):
+        return problem
+    at_zero = list(joints)
+    for i in held:
+        at_zero[i] = replace(joints[i], value=0.0, lower=0.0, upper=0.0)
+    shape = replace(problem, chain=replace(problem.chain, joints=tuple(at_zero)))
+    jacobian = tracking_jacobian(shape)  # the held values are inputs of it: one function for both
+    if not np.array_equal(q_independent_rows(problem, jacobian=jacobian), q_independent_rows(shape, jacobian=jacobian)):
+        return problem
+    return shape
+
+
+def _plus_zero(x: float) -> bool:
+    """x is +0.0 (a joint held at -0.0 pickles differently, so it is moved to +0.0 too)."""
+    return x == 0.0 and not np.signbit(x)

@@ -30,6 +30,9 @@ class Prepared(Protocol):
 
     def solve(self, x0: np.ndarray, bound: Bound | None = None) -> Outcome: ...
 
+    def bounded(self, lower: np.ndarray, upper: np.ndarray) -> Prepared:
+        """The same solver with the design joints (x[:n_design]) bounded by ``lower`` and ``upper``."""
+
 
 class Backend(Protocol):
     name: str

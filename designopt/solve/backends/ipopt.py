@@ -12,6 +12,7 @@ their bound 0 and a push of 1 cm changes the problem. Observers (`designopt.solv
 from __future__ import annotations
 
 import contextlib
+import copy
 import io
 import os
 import sys
@@ -147,13 +148,27 @@ class PreparedIpopt:
         # every solve when that count exceeds the variables, although IPOPT removes them and solves (a held planar
         # arm's tracking rows are redundant, not too many: the sweep's held RR, RP, PR on 10 waypoints converge).
         self._casadi_warns = nlp.n_equalities + int(np.sum(nlp.lbx == nlp.ubx)) > nlp.n_variables
+        self.lbx, self.ubx = nlp.lbx, nlp.ubx
         self.prepare_time_s = time.perf_counter() - t0
+
+    def bounded(self, lower: np.ndarray, upper: np.ndarray) -> PreparedIpopt:
+        """This solver with the design joints (x[:n_design]) between ``lower`` and ``upper`` instead of the NLP's
+        own bounds: the same nlpsol and observers, so that problems which differ only there share one build
+        (`designopt.transcriptions.degeneracy.shared_shape`). Which joints are fixed (lower == upper) must be
+        the NLP's own."""
+        lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+        n = self.nlp.n_design
+        if not np.array_equal(lower == upper, self.lbx[:n] == self.ubx[:n]):
+            raise ValueError("a bounded solver must fix the design joints its NLP fixes, and only those")
+        view = copy.copy(self)
+        view.lbx, view.ubx = np.r_[lower, self.lbx[n:]], np.r_[upper, self.ubx[n:]]
+        return view
 
     def solve(self, x0: np.ndarray, bound: Bound | None = None) -> Outcome:
         """Solve from x0 (clipped into the bounds); ``bound``: what the observers may hold the solve to
         (`designopt.solve.observers.AboveBound`). A solve that fails is an outcome with its status."""
         nlp = self.nlp
-        x0 = np.clip(np.asarray(x0, float), nlp.lbx, nlp.ubx)
+        x0 = np.clip(np.asarray(x0, float), self.lbx, self.ubx)
         for o in self.observers:
             o.reset(bound)
         if nlp.n_equalities > nlp.n_variables:
@@ -164,7 +179,7 @@ class PreparedIpopt:
         # CasADi writes its warnings through Python's stderr: caught only where it would warn, the rest passed on
         quiet = contextlib.redirect_stderr(io.StringIO()) if self._casadi_warns else contextlib.nullcontext()
         with quiet as said:
-            sol = self.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+            sol = self.solver(x0=x0, lbx=self.lbx, ubx=self.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
         if said is not None:
             sys.stderr.write("".join(line for line in said.getvalue().splitlines(keepends=True)
                                      if "NLP is overconstrained" not in line))
