@@ -179,3 +179,29 @@ def test_held_problems_share_one_nlp_and_solve_as_if_built_alone():
     lower = np.array([j.lower for j in design])
     with pytest.raises(ValueError, match="fix the design joints"):
         solver.bounded(lower, lower)
+
+
+def test_a_backend_that_cannot_move_bounds_builds_each_held_problem(monkeypatch):
+    """A backend whose prepared solver has no `bounded`: a held problem is built and solved as itself."""
+    from types import SimpleNamespace
+
+    from designopt.solve import local
+    from designopt.solve.backends import BACKENDS
+    from designopt.solve.backends.ipopt import Ipopt
+    from designopt.solve.profile import SolverProfile
+    from designopt.transcriptions.collocation import Collocation
+
+    class Plain:
+        name = "plain"
+
+        def prepare(self, nlp, profile):
+            inner = Ipopt().prepare(nlp, profile)
+            return SimpleNamespace(solve=inner.solve, prepare_time_s=inner.prepare_time_s)
+
+    monkeypatch.setitem(BACKENDS, "plain", Plain)
+    _, problem = design_only(waypoints=8)
+    held, at = held_at_multiples_of_pi(problem, planar_design(problem))
+    built, solver, spent = local.prepared(held, Collocation(), SolverProfile(backend="plain", max_iter=40))
+    assert built.problem.chain == held.chain and spent > 0
+    outcome = solver.solve(built.pack(initial_guess(held, 0, 0, 0.3, "ik")))
+    np.testing.assert_array_equal(outcome.x[: len(at)][twists(held)], at[twists(held)])

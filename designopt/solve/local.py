@@ -41,13 +41,27 @@ def _prepared(key: str, payload: bytes, profile: SolverProfile):
 
 def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
     """(built NLP, prepared solver, seconds this call spent building and preparing: 0 when both were cached).
-    A problem with held design joints is built as its `shared_shape` (held at 0) and solved with its own bounds,
-    so that the held problems of a search share one build per set of held joints.
+    A problem with held design joints is built as its `shared_shape` (held at 0) and solved with its own bounds
+    (`Prepared.bounded`, when the backend has it), so that the held problems of a search share one build per set
+    of held joints.
     A cached solver whose blocks have since tiered up to -O1 (`designopt.transcriptions.compiled`; another
     process may have built them) is built again, so that a long run gains from its tier-up at once."""
     t0 = time.perf_counter()
     shape = shared_shape(problem)
-    payload = pickle.dumps((shape, transcription))
+    built, solver, fresh = _cached(shape, transcription, profile)
+    if shape is not problem:
+        if hasattr(solver, "bounded"):
+            design = problem.chain.design
+            solver = solver.bounded([j.lower for j in design], [j.upper for j in design])
+        else:  # a backend that cannot move the design joints' bounds: this problem's own build
+            built, solver, again = _cached(problem, transcription, profile)
+            fresh = fresh or again
+    return built, solver, (time.perf_counter() - t0) if fresh else 0.0
+
+
+def _cached(problem: DesignProblem, transcription, profile: SolverProfile):
+    """(built NLP, prepared solver, whether this call built or prepared it) of the problem, from the caches."""
+    payload = pickle.dumps((problem, transcription))
     key = hashlib.sha256(payload).hexdigest()
     misses = _prepared.cache_info().misses
     built, solver = _prepared(key, payload, profile)
@@ -57,10 +71,7 @@ def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
         _prepared.cache_clear()
         built, solver = _prepared(key, payload, profile)
         fresh = True
-    if shape is not problem:
-        design = problem.chain.design
-        solver = solver.bounded([j.lower for j in design], [j.upper for j in design])
-    return built, solver, (time.perf_counter() - t0) if fresh else 0.0
+    return built, solver, fresh
 
 
 def solve_guess(problem: DesignProblem, transcription, profile: SolverProfile, guess: InitialGuess,

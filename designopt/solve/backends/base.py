@@ -31,7 +31,8 @@ class Prepared(Protocol):
     def solve(self, x0: np.ndarray, bound: Bound | None = None) -> Outcome: ...
 
     def bounded(self, lower: np.ndarray, upper: np.ndarray) -> Prepared:
-        """The same solver with the design joints (x[:n_design]) bounded by ``lower`` and ``upper``."""
+        """The same solver with the design joints (x[:n_design]) bounded by ``lower`` and ``upper``. Optional: without
+        it, each problem with held design joints is built on its own (`designopt.solve.local.prepared`)."""
 
 
 class Backend(Protocol):
