@@ -71,10 +71,20 @@ def build_seconds(name: str, cache: str, compile_mode: str | None) -> tuple[floa
     return float(wall), float(cpu)
 
 
+def landed(cache: str, seconds: float = 600.0) -> None:
+    """Wait until the compile cache ``cache`` has no build under way (a cold build leaves its blocks' -O0 builds
+    running in the background: a warm build is one that finds their libraries)."""
+    deadline = time.time() + seconds
+    while time.time() < deadline and any(Path(cache).glob("*.lock")):
+        time.sleep(0.1)
+
+
 def measure(name: str, starts: int, options: tuple = (), compile_mode: str | None = None) -> dict:
     problem, search = setup(*PROBLEMS[name], options, compile_mode)
     with tempfile.TemporaryDirectory() as cache:
-        (cold, _), (warm, _) = build_seconds(name, cache, compile_mode), build_seconds(name, cache, compile_mode)
+        cold, _ = build_seconds(name, cache, compile_mode)
+        landed(cache)
+        warm, _ = build_seconds(name, cache, compile_mode)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for start in range(starts):
@@ -151,6 +161,7 @@ def main() -> None:
     if args.build:
         with tempfile.TemporaryDirectory() as cache:
             cold = build_seconds(args.build, cache, args.compile)
+            landed(cache)
             warms = [build_seconds(args.build, cache, args.compile) for _ in range(args.repeat)]
         wall, cpu = statistics.median(w for w, _ in warms), statistics.median(c for _, c in warms)
         print(f"{args.build}: build cold {cold[0]:.2f} s (CPU {cold[1]:.3f} s), warm {wall:.2f} s (CPU {cpu:.3f} s; "

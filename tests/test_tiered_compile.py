@@ -1,5 +1,6 @@
-"""Tiered compilation of the per-waypoint blocks (`designopt.transcriptions.compiled`): -O0 first, -O1 once the
-solves that used a block add up to the tier-up threshold. The two levels must compute the same numbers to the last
+"""Tiered compilation of the per-waypoint blocks (`designopt.transcriptions.compiled`): -O0 first (a large block
+interpreted while gcc builds it in the background), -O1 once the solves that used a block add up to the tier-up
+threshold. The two levels must compute the same numbers to the last
 bit (a solve may switch levels between runs and must not change), which is checked here against the interpreted
 function as the independent truth."""
 
@@ -15,12 +16,15 @@ from designopt.config import parse_config
 from designopt.problem import problem_from_config
 from designopt.solve import Seeded, SolverProfile, solve_guess
 from designopt.transcriptions import Collocation
+from designopt.transcriptions import compiled as compiled_module
 from designopt.transcriptions.compiled import (
     compiled,
+    interpreted_at,
     library_at,
     record_work,
     source_of,
     tier_up_after,
+    tiered_up,
 )
 from designopt.transcriptions.hessian import block_hessian_function
 
@@ -49,6 +53,122 @@ def test_o0_and_o1_compute_the_same_bits(tmp_path, monkeypatch):
         args = [rng.normal(size=6), rng.normal(), rng.normal(size=2), rng.normal(size=2)]
         out = {mode: np.array(fn(*args)).ravel() for mode, fn in levels.items()}
         assert np.array_equal(out["O0"], out["O1"]) and np.array_equal(out["O0"], out["none"])
+
+
+def _landed(libraries, level="O0", seconds=120.0) -> bool:
+    """Whether every library's ``level`` build lands in the cache within ``seconds``."""
+    deadline = time.time() + seconds
+    while time.time() < deadline and not all(library_at(_stem(lib), level).exists() for lib in libraries):
+        time.sleep(0.1)
+    return all(library_at(_stem(lib), level).exists() for lib in libraries)
+
+
+def test_a_small_block_waits_for_gcc_even_with_background_builds_on(tmp_path, monkeypatch):
+    """A block whose C source is below `BACKGROUND_FROM_BYTES` is compiled at -O0 where it is first needed, as
+    without background builds: its library is loaded at once and reported, nothing is interpreted."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    x = ca.SX.sym("x", 3)
+    fn = ca.Function("blk8", [x], [ca.cos(x[0]) * ca.sumsqr(x) - x[1] / (2 + x[2] ** 2)])
+    assert len(compiled_module._source(fn)) < compiled_module.BACKGROUND_FROM_BYTES
+    used = []
+    compiled(fn, "tiered", used)
+    assert len(used) == 1 and used[0].name.endswith(".O0.so") and used[0].exists()
+    assert not list(tmp_path.glob("*.lock"))
+
+
+def test_a_new_large_block_is_interpreted_while_its_o0_library_builds(tmp_path, monkeypatch):
+    """With background builds on, a block at or above `BACKGROUND_FROM_BYTES` (here: every block) the cache has no
+    library of is the interpreted function at once, its C source kept and its -O0 build started; its marker is
+    reported, `tiered_up` turns true once the library lands, and the next load is that library, computing the same
+    bits."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    monkeypatch.setattr(compiled_module, "BACKGROUND_FROM_BYTES", 0)
+    x = ca.SX.sym("x", 3)
+    fn = ca.Function("blk6", [x], [ca.cos(x[0]) * ca.sumsqr(x) - x[1] / (2 + x[2] ** 2)])
+    used = []
+    first = compiled(fn, "tiered", used)
+    stem = _stem(used[0])
+    assert used == [interpreted_at(stem)] and source_of(stem).exists()
+    assert _landed(used)
+    assert tiered_up(used)
+    again = []
+    loaded = compiled(fn, "tiered", again)
+    assert again == [library_at(stem, "O0")] and not tiered_up(again)
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        x0 = rng.normal(size=3)
+        assert np.array_equal(np.array(loaded(x0)), np.array(first(x0)))
+    assert not list(tmp_path.glob("*.lock")) and not list(tmp_path.glob("*.tmp*"))
+
+
+def test_tiered_up_waits_for_every_interpreted_block(tmp_path, monkeypatch):
+    """An NLP whose blocks are interpreted is built again once all of them have a library, not once per block;
+    one of its -O0 libraries gaining an -O1 one is enough, as before."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    a, b, c = (tmp_path / f"blk{k}_0123456789abcdef012{k}" for k in range(3))
+    waiting = [interpreted_at(a), interpreted_at(b)]
+    assert not tiered_up(waiting)
+    library_at(a, "O0").write_bytes(b"")
+    assert not tiered_up(waiting)
+    library_at(b, "O1").write_bytes(b"")  # tiered up past -O0 (another process)
+    assert tiered_up(waiting)
+    assert not tiered_up([library_at(c, "O0")])
+    library_at(c, "O1").write_bytes(b"")
+    assert tiered_up([library_at(c, "O0"), interpreted_at(tmp_path / "blk9_0123456789abcdef0129")])
+
+
+def test_a_failed_background_build_leaves_the_block_interpreted(tmp_path, monkeypatch):
+    """A compiler that fails leaves a large block interpreted with its build's lock kept: the NLP is not built
+    again and later loads start no build until the lock is stale."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    monkeypatch.setattr(compiled_module, "BACKGROUND_FROM_BYTES", 0)
+    monkeypatch.setenv("CC", "false")
+    x = ca.SX.sym("x", 2)
+    fn = ca.Function("blk7", [x], [ca.sinh(x[0]) * x[1]])
+    used = []
+    compiled(fn, "tiered", used)
+    stem = _stem(used[0])
+    lock = library_at(stem, "O0").with_name(library_at(stem, "O0").name + ".lock")
+    deadline = time.time() + 30
+    while time.time() < deadline and list(tmp_path.glob("*.tmp*")):
+        time.sleep(0.1)
+    assert lock.exists() and not library_at(stem, "O0").exists() and not tiered_up(used)
+    mtime = lock.stat().st_mtime
+    assert compiled(fn, "tiered", []) is not None and lock.stat().st_mtime == mtime
+
+
+def test_a_cached_solver_is_built_again_once_its_blocks_have_libraries(tmp_path, monkeypatch):
+    """A worker's solver prepared while its (large) blocks were interpreted is reused until their -O0 libraries
+    land, then prepared anew at its next solve with them; a start solves the same to the bit either way."""
+    from designopt.solve import local
+
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    monkeypatch.setattr(compiled_module, "BACKGROUND_FROM_BYTES", 0)
+    slow = tmp_path / "slow-cc"  # a compiler that takes its time: the first solve is surely interpreted
+    slow.write_text('#!/bin/sh\nsleep 3\nexec gcc "$@"\n')
+    slow.chmod(0o755)
+    monkeypatch.setenv("CC", str(slow))
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 5}, "robot": {"structure": "RRR",
+                                                                                    "dh": "generic"}}
+    problem, profile = problem_from_config(parse_config(cfg)), SolverProfile(max_iter=40)
+    built, solver, _ = local.prepared(problem, Collocation(), profile)
+    waiting = built.nlp.tiered_libraries(profile.compile)
+    assert waiting and all(lib.name.endswith(".none.so") for lib in waiting)
+    guess = Seeded(0, 1).guess(problem)
+    before = solve_guess(problem, Collocation(), profile, guess)
+    assert local.prepared(problem, Collocation(), profile)[1] is solver  # still interpreted, reused
+    assert _landed(waiting)
+    again, fresh, spent = local.prepared(problem, Collocation(), profile)
+    assert fresh is not solver and spent > 0
+    assert all(lib.name.endswith(".O0.so") for lib in again.nlp.tiered_libraries(profile.compile))
+    after = solve_guess(problem, Collocation(), profile, guess)
+    assert after.raw.iterations == before.raw.iterations and np.array_equal(after.raw.q_d, before.raw.q_d)
+    assert np.array_equal(after.raw.trajectory.Q, before.raw.trajectory.Q)
+    assert np.array_equal(after.raw.trajectory.V, before.raw.trajectory.V)
 
 
 def test_a_block_tiers_up_once_its_solves_reach_the_threshold(tmp_path, monkeypatch):

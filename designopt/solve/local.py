@@ -44,8 +44,9 @@ def prepared(problem: DesignProblem, transcription, profile: SolverProfile):
     A problem with held design joints is built as its `shared_shape` (held at 0) and solved with its own bounds
     (`Prepared.bounded`, when the backend has it), so that the held problems of a search share one build per set
     of held joints.
-    A cached solver whose blocks have since tiered up to -O1 (`designopt.transcriptions.compiled`; another
-    process may have built them) is built again, so that a long run gains from its tier-up at once."""
+    A cached solver whose blocks have since tiered up (`designopt.transcriptions.compiled.tiered_up`: -O0
+    libraries for blocks it interprets, or -O1 ones; another process may have built them) is built again, so that
+    a run gains from each tier at once."""
     t0 = time.perf_counter()
     shape = shared_shape(problem)
     built, solver, fresh = _cached(shape, transcription, profile)

@@ -4,14 +4,19 @@ Only per-waypoint functions are compiled (a few thousand lines of C, seconds); c
 takes minutes. The cache lives in ``$DESIGNOPT_CACHE`` or ``~/.cache/designopt`` and is safe to share
 between processes: each library is written under a temporary name and renamed into place.
 
-Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block is first
-compiled at gcc -O0 (about 1 s for the main job's Hessian block) and used so; every solve that used it adds its
-seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the same C source is
-compiled again at -O1 in a detached background process (about 10 s for that block), which later builds, in any
-process, load instead (`designopt cache` shows where each block stands). Every library is compiled with
-``-ffp-contract=off`` (and never with -ffast-math), so -O0 and -O1 compute the same IEEE operations in the same
-order: a solve is the same to the last bit at either level, only faster at -O1 (the main job's default search:
-0.79x the CPU, docs/benchmarks.md).
+Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block the cache
+has no library of yet is compiled at -O0 where it is first needed (about 2 s for the main job's Hessian block),
+or, when its C source is large (`BACKGROUND_FROM_BYTES`: a cell's Hessian block, about 4 s of gcc), interpreted at
+once while gcc builds it in a detached background process; later builds, in any process, load that library (a
+worker's cached solver is built again once all of its blocks have theirs: `tiered_up`). Every solve that used a
+tiered block adds its seconds to the block's record in the cache, and once those reach `tier_up_after` seconds
+the same C source is compiled again at -O1 in the background (about 10 s for that block), which later builds load
+instead (`designopt cache` shows where each block stands). Every library is compiled with ``-ffp-contract=off``
+(and never with -ffast-math), so CasADi's virtual machine, -O0 and -O1 compute the same IEEE operations in the
+same order: a solve is the same to the last bit at any level, only faster compiled (the main job's default search:
+0.79x the CPU at -O1, docs/benchmarks.md), and a first build need not wait for a long compile. With
+`tier_up_after` ``never`` nothing is built in the background: a tiered block is compiled at -O0 where it is first
+needed and stays there.
 """
 
 from __future__ import annotations
@@ -45,6 +50,14 @@ AUTO_O1_FROM = 500
 # for about 15 s and never tiers up; a task run again and again does from its second run.
 # `DESIGNOPT_TIER_UP_AFTER` (seconds, or ``never``) overrides it.
 TIER_UP_AFTER = 60.0
+# A tiered block whose C source has this many bytes or more, and no library yet, is interpreted while gcc builds its
+# -O0 library in the background; a smaller one waits for gcc here. gcc -O0 takes about 2 us per byte (0.35 s at
+# 0.23 MB, 1.1 s at 0.54 MB, 9.5 s at 4.7 MB): the main job's Hessian block (0.96 MB, about 2 s) and every sweep
+# structure's and modular assignment's wait; a cell's (the pocket cell's 1.95 MB, about 4 s) does not. Interpreted
+# solves cost 2-4x a compiled Hessian call and the background gcc runs beside busy workers, so the wait is worth
+# skipping only where it is long: measured, the pocket cell's cold build 5.2-6.1 -> 1.5 s, while the modular
+# experiment's many small shapes lost 1.26-1.47x with every block backgrounded (docs/decisions.md).
+BACKGROUND_FROM_BYTES = 1_500_000
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
 
 
@@ -93,7 +106,10 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
     so that a function found there is never derived (its symbolic derivation and serialisation are most of a
     warm build). Mode ``none``: ``derive()`` itself. Level ``tiered``: the -O1 library if the cache has it, else
     the -O0 one (its C source kept beside it for the tier-up), whose path is appended to ``used`` so that the
-    solves that use it can be counted (`record_work`)."""
+    solves that use it can be counted (`record_work`); with neither in the cache, the -O0 library built here, or,
+    for C source of `BACKGROUND_FROM_BYTES` or more, ``derive()`` itself while its -O0 library is built in the
+    background (`build_later`), with its `interpreted_at` marker appended to ``used`` (`tiered_up` tells when the
+    library has landed). Without background builds (`tier_up_after` None) every -O0 library is built here."""
     if mode == "none":
         return derive()
     if mode not in ("O0", "O1", "O2", "tiered"):
@@ -109,8 +125,14 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
     library = library_at(stem, mode)
     if not library.exists():
         fn = derive()
+        background = tiered and tier_up_after() is not None
         try:
+            if background and source_of(stem).exists():  # a large block whose -O0 build is under way (or died)
+                return _interpreted_meanwhile(stem, fn, used)
             source = _source(fn)
+            if background and len(source) >= BACKGROUND_FROM_BYTES:
+                _write_atomically(source_of(stem), gzip.compress(source.encode(), compresslevel=1))
+                return _interpreted_meanwhile(stem, fn, used)
             _build(source, library, mode)
         except (OSError, subprocess.CalledProcessError):
             return fn
@@ -121,9 +143,24 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
     return ca.external(name, str(library))
 
 
+def _interpreted_meanwhile(stem: Path, fn: ca.Function, used: list[Path] | None) -> ca.Function:
+    """``fn``, interpreted while the block's -O0 library is built from its kept C source in the background (a build
+    under way in this or another process is left to it: `build_later`'s lock), its `interpreted_at` marker appended
+    to ``used``."""
+    build_later(stem, "O0")
+    if used is not None:
+        used.append(interpreted_at(stem))
+    return fn
+
+
 def library_at(stem: Path, mode: str) -> Path:
     """The cache's library of ``stem`` (``<cache>/<name>_<key>``) compiled at level ``mode``."""
     return stem.with_name(f"{stem.name}.{mode}.so")
+
+
+def interpreted_at(stem: Path) -> Path:
+    """The marker that stands for ``stem``'s block interpreted while its -O0 library is built (no such file)."""
+    return stem.with_name(f"{stem.name}.none.so")
 
 
 def source_of(stem: Path) -> Path:
@@ -136,9 +173,9 @@ def _stem(library: Path) -> Path:
 
 
 def record_work(libraries: Iterable[Path], seconds: float, background: bool = True) -> list[Path]:
-    """Count ``seconds`` of solving towards the tier-up of each tiered -O0 library in ``libraries`` (paths that
-    `compiled_as` appended to its ``used``), and start the -O1 build of each whose count has reached
-    `tier_up_after` (in a detached background process unless ``background`` is false;
+    """Count ``seconds`` of solving towards the tier-up of each tiered block in ``libraries`` (paths that
+    `compiled_as` appended to its ``used``: -O0 libraries and interpreted markers), and start the -O1 build of
+    each whose count has reached `tier_up_after` (in a detached background process unless ``background`` is false;
     one process builds it, others find its lock). Returns the libraries whose -O1 build this call started."""
     after = tier_up_after()
     started = []
@@ -159,16 +196,28 @@ def record_work(libraries: Iterable[Path], seconds: float, background: bool = Tr
 
 
 def tiered_up(libraries: Iterable[Path]) -> bool:
-    """Whether any of these tiered -O0 libraries has an -O1 library in the cache by now (a stat each)."""
-    return any(library_at(_stem(library), "O1").exists() for library in libraries)
+    """Whether these tiered blocks (`compiled_as`'s ``used``) load faster by now: any -O0 library has an -O1 one
+    in the cache, or every interpreted block (`interpreted_at`) has a library (a stat or two each). One rebuild
+    per NLP once its blocks have all landed, not one per block."""
+    libraries = list(libraries)
+    waiting = [lib for lib in libraries if lib.name.endswith(".none.so")]
+    if waiting and all(library_at(_stem(lib), "O0").exists() or library_at(_stem(lib), "O1").exists()
+                       for lib in waiting):
+        return True
+    return any(library_at(_stem(lib), "O1").exists() for lib in libraries if lib not in waiting)
 
 
 def tier_up(stem: Path, background: bool = True) -> bool:
-    """Build ``stem``'s kept C source at -O1 into its -O1 library (atomically: under a temporary name, then
+    """Build ``stem``'s kept C source at -O1 (`build_later`)."""
+    return build_later(stem, "O1", background)
+
+
+def build_later(stem: Path, level: str, background: bool = True) -> bool:
+    """Build ``stem``'s kept C source at ``level`` into its library (atomically: under a temporary name, then
     renamed), in a detached background process, or here when ``background`` is false. False when there is no
     source, or another process holds the build's lock. A build that fails keeps its lock, so that it is tried
     again only once the lock is stale (`STALE_LOCK_S`), not after every solve."""
-    source, target = source_of(stem), library_at(stem, "O1")
+    source, target = source_of(stem), library_at(stem, level)
     lock = target.with_name(f"{target.name}.lock")
     if not source.exists() or not _take(lock):
         return False
@@ -178,7 +227,7 @@ def tier_up(stem: Path, background: bool = True) -> bool:
     try:
         c_file.write_bytes(gzip.decompress(source.read_bytes()))
         c, out = q(str(c_file)), q(str(tmp))
-        build = (f"{shlex.join(_compile_command(c_file, tmp, 'O1'))} && mv -f {out} {q(str(target))} && "
+        build = (f"{shlex.join(_compile_command(c_file, tmp, level))} && mv -f {out} {q(str(target))} && "
                  f"rm -f {q(str(lock))}; rm -f {out} {c}")
         # in the background the shell returns at once and the build, orphaned, outlives this process
         command = f"({build}) >/dev/null 2>&1" + (" &" if background else "")

@@ -166,9 +166,10 @@ class NLP:
         return self._tiered.setdefault(compile_mode, [])
 
     def tiered_libraries(self, compile_mode: str) -> tuple:
-        """The compile cache's -O0 libraries of this NLP's block functions under ``compile_mode`` that tier up to
-        -O1 once solved with long enough (`designopt.transcriptions.compiled.record_work`): empty once they have,
-        or for any mode but ``auto``."""
+        """This NLP's tiered block functions under ``compile_mode``: the compile cache's -O0 libraries that tier up
+        to -O1 once solved with long enough (`designopt.transcriptions.compiled.record_work`), and the markers of
+        blocks interpreted while their -O0 library is built (`compiled.interpreted_at`); empty once all are at
+        -O1, or for any mode but ``auto``."""
         return tuple(dict.fromkeys(self._tiered.get(compile_mode, ())))
 
     def _inputs(self, block: BlockStructure) -> list:
