@@ -18,6 +18,7 @@ from designopt.solve import Seeded, SolverProfile, solve_guess
 from designopt.transcriptions import Collocation
 from designopt.transcriptions import compiled as compiled_module
 from designopt.transcriptions.compiled import (
+    built_together,
     compiled,
     interpreted_at,
     library_at,
@@ -138,6 +139,144 @@ def test_a_failed_background_build_leaves_the_block_interpreted(tmp_path, monkey
     assert lock.exists() and not library_at(stem, "O0").exists() and not tiered_up(used)
     mtime = lock.stat().st_mtime
     assert compiled(fn, "tiered", []) is not None and lock.stat().st_mtime == mtime
+
+
+def _counting_compiler(tmp_path):
+    """A compiler that notes how many of its copies run at once (in ``tmp_path/overlap``) and takes half a second
+    before calling gcc."""
+    cc = tmp_path / "counting-cc"
+    cc.write_text(f'#!/bin/sh\nd={tmp_path}/running\nmkdir -p $d\ntouch $d/$$\nls $d | wc -l >> {tmp_path}/overlap\n'
+                  'sleep 0.5\nrm -f $d/$$\nexec gcc "$@"\n')
+    cc.chmod(0o755)
+    return cc
+
+
+def test_blocks_met_together_are_compiled_together_on_leaving(tmp_path, monkeypatch):
+    """Inside `built_together` a missing block is its interpreted function and nothing is compiled; on leaving, every
+    noted block is compiled, as many at once as the process has cores and never more, its source kept; a block met
+    again then loads its library, computing the same bits."""
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    monkeypatch.setenv("CC", str(_counting_compiler(tmp_path)))
+    x = ca.SX.sym("x", 3)
+    fns = [ca.Function(f"blk1{k}", [x], [ca.cos(k * x[0]) * ca.sumsqr(x) - x[1] / (2 + x[2] ** 2)]) for k in range(3)]
+    inside = []
+    with built_together() as batch:
+        for fn in fns:
+            inside.append(compiled(fn, "tiered", []))
+            inside.append(compiled(fn, "tiered", []))  # met twice (two blocks of one shape): built once
+        assert not list(cache.glob("*.so"))
+    assert all(f.class_name() == "SXFunction" for f in inside) and len(batch.here) == 6
+    cores = len(os.sched_getaffinity(0))
+    overlap = [int(v) for v in (tmp_path / "overlap").read_text().split()]
+    assert len(overlap) == 3 and max(overlap) == min(cores, 3)
+    rng = np.random.default_rng(5)
+    for fn, first in zip(fns, inside[::2], strict=True):
+        used = []
+        loaded = compiled(fn, "tiered", used)
+        assert loaded.class_name() == "External" and used[0].name.endswith(".O0.so")
+        assert source_of(_stem(used[0])).exists()
+        x0 = rng.normal(size=3)
+        assert np.array_equal(np.array(loaded(x0)), np.array(first(x0)))
+    assert len((tmp_path / "overlap").read_text().split()) == 3  # nothing compiled again
+    assert not list(cache.glob("*.tmp*")) and not [d for d in cache.iterdir() if d.is_dir()]
+
+
+def test_a_block_another_process_is_building_is_waited_for_not_built_twice(tmp_path, monkeypatch):
+    """Two workers starting on one shape: a library whose lock another process holds is not compiled again on
+    leaving `built_together` but waited for, and loaded once it lands; a lock whose holder never delivers is waited
+    for only so long, and left alone."""
+    import shutil
+    import threading
+
+    cache, elsewhere = tmp_path / "cache", tmp_path / "elsewhere"
+    x = ca.SX.sym("x", 3)
+    fn = ca.Function("blk31", [x], [ca.sin(x[0]) * ca.sumsqr(x)])
+    mine = ca.Function("blk32", [x], [ca.cos(x[1]) * ca.sumsqr(x)])
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(elsewhere))
+    theirs = []
+    compiled(fn, "tiered", theirs)  # the other process's build, made beforehand
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    monkeypatch.setenv("CC", str(_counting_compiler(tmp_path)))
+    target = cache / theirs[0].name
+    lock = target.with_name(target.name + ".lock")
+    cache.mkdir()
+    lock.write_bytes(b"")
+
+    def deliver():
+        time.sleep(1.0)
+        shutil.copy(theirs[0], target.with_name(target.name + ".part"))
+        os.replace(target.with_name(target.name + ".part"), target)
+        lock.unlink()
+
+    other = threading.Thread(target=deliver)
+    other.start()
+    with built_together() as batch:
+        compiled(fn, "tiered", [])
+        compiled(mine, "tiered", [])
+    other.join()
+    assert len(batch.here) == 2 and target.exists()
+    assert len((tmp_path / "overlap").read_text().split()) == 1  # only its own block was compiled
+    assert compiled(fn, "tiered", []).class_name() == "External"
+    assert not list(cache.glob("*.lock"))
+    gone = ca.Function("blk33", [x], [ca.tan(x[2]) * x[0]])
+    with built_together() as batch:
+        compiled(gone, "tiered", [])
+    (source, library), = batch.here
+    library.unlink()
+    stuck = library.with_name(library.name + ".lock")
+    stuck.write_bytes(b"")
+    compiled_module._build_all(batch.here, wait_s=0.3)
+    assert not library.exists() and stuck.exists()
+
+
+def test_a_large_block_in_a_batch_goes_to_the_background_after_the_batch(tmp_path, monkeypatch):
+    """A large block met inside `built_together` is interpreted and reported as before, but its background build
+    starts only on leaving, after the batch's own builds; a compiler that fails leaves the batch's blocks
+    interpreted where they are next met, nothing raised."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    monkeypatch.setattr(compiled_module, "BACKGROUND_FROM_BYTES", 0)
+    x = ca.SX.sym("x", 2)
+    fn = ca.Function("blk21", [x], [ca.tanh(x[0]) * x[1]])
+    used = []
+    with built_together() as batch:
+        compiled(fn, "tiered", used)
+        stem = _stem(used[0])
+        assert used == [interpreted_at(stem)] and source_of(stem).exists()
+        assert not list(tmp_path.glob("*.lock")) and not library_at(stem, "O0").exists()
+    assert batch.later == [stem] and not batch.here
+    assert _landed(used)
+    monkeypatch.setattr(compiled_module, "BACKGROUND_FROM_BYTES", 10**9)
+    monkeypatch.setenv("CC", "false")
+    other = ca.Function("blk22", [x], [ca.tanh(x[1]) * x[0]])
+    with built_together() as batch:
+        compiled(other, "tiered", [])
+    assert len(batch.here) == 1 and not list(tmp_path.glob("blk22*.so"))
+    assert compiled(other, "tiered", []).class_name() == "SXFunction"
+
+
+def test_a_problem_built_cold_loads_a_library_for_every_block(tmp_path, monkeypatch):
+    """An NLP built with an empty cache compiles its blocks together and is then made with their libraries: every
+    tiered block it reports is an -O0 library in the cache, every library compiled is one it loads, and its
+    Hessian of the Lagrangian equals the interpreted one's to the bit."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 5}, "robot": {"structure": "RRR",
+                                                                                    "dh": "generic"}}
+    problem = problem_from_config(parse_config(cfg))
+    nlp = Collocation().build(problem).nlp
+    _, pieces = nlp.derivatives("auto")
+    reported = nlp.tiered_libraries("auto")
+    assert reported and all(lib.name.endswith(".O0.so") and lib.exists() for lib in reported)
+    assert set(reported) == set(tmp_path.glob("*.O0.so"))
+    _, interpreted = nlp.derivatives("none")
+    rng = np.random.default_rng(11)
+    args = [rng.normal(size=nlp.n_variables), ca.DM(0, 1), 1.0, rng.normal(size=nlp.n_constraints)]
+    compiled_h, interpreted_h = pieces["hess_lag"](*args), interpreted["hess_lag"](*args)
+    assert np.array_equal(np.array(ca.DM(compiled_h)), np.array(ca.DM(interpreted_h)))
 
 
 def test_a_cached_solver_is_built_again_once_its_blocks_have_libraries(tmp_path, monkeypatch):

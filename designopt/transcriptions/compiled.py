@@ -4,6 +4,10 @@ Only per-waypoint functions are compiled (a few thousand lines of C, seconds); c
 takes minutes. The cache lives in ``$DESIGNOPT_CACHE`` or ``~/.cache/designopt`` and is safe to share
 between processes: each library is written under a temporary name and renamed into place.
 
+A problem's blocks the cache lacks are compiled together (`built_together`, what an NLP's build does): gcc runs
+on as many of them at once as there are cores, and a library another process is already building (two workers
+starting on one shape) is waited for, not built twice.
+
 Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block the cache
 has no library of yet is compiled at -O0 where it is first needed (about 2 s for the main job's Hessian block),
 or, when its C source is large (`BACKGROUND_FROM_BYTES`: a cell's Hessian block, about 4 s of gcc), interpreted at
@@ -28,8 +32,10 @@ import shlex
 import subprocess
 import tempfile
 import time
-from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import casadi as ca
@@ -59,6 +65,43 @@ TIER_UP_AFTER = 60.0
 # experiment's many small shapes lost 1.26-1.47x with every block backgrounded (docs/decisions.md).
 BACKGROUND_FROM_BYTES = 1_500_000
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
+
+
+@dataclass
+class BuildBatch:
+    """The library builds that `compiled_as` noted instead of running them, inside `built_together`: (C source,
+    library) pairs to compile here, and the stems of large blocks whose -O0 build goes to the background after
+    them."""
+
+    here: list[tuple[str, Path]] = field(default_factory=list)
+    later: list[Path] = field(default_factory=list)
+
+
+# The batch of the innermost `built_together` of this thread or task, if any (a context variable, so that each
+# thread's builds are its own).
+_BATCH: ContextVar[BuildBatch | None] = ContextVar("designopt_build_batch", default=None)
+
+
+@contextmanager
+def built_together() -> Iterator[BuildBatch]:
+    """Within it, a library `compiled_as` would build where it is met is only noted (its C source generated) and the
+    interpreted function stands in for it; on leaving, every noted build runs at once, gcc processes in parallel
+    on the machine's cores, longest first, and only then do the noted background builds start. A problem's
+    small blocks thus cost the longest of their compiles, not their sum, and the background build of a large one
+    does not take a core from them. The batch yielded is non-empty when functions made inside hold interpreted
+    stand-ins: made again, they load the libraries (`designopt.transcriptions.nlp.NLP.derivatives`)."""
+    batch = BuildBatch()
+    token = _BATCH.set(batch)
+    try:
+        yield batch
+    finally:
+        _BATCH.reset(token)
+        try:
+            _build_all(batch.here)
+        except OSError:  # a cache that cannot be written: the blocks are built, or interpreted, where next met
+            pass
+        for stem in batch.later:
+            build_later(stem, "O0")
 
 
 def level(mode: str, points: int) -> str:
@@ -126,18 +169,22 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
     if not library.exists():
         fn = derive()
         background = tiered and tier_up_after() is not None
+        batch = _BATCH.get()
         try:
             if background and source_of(stem).exists():  # a large block whose -O0 build is under way (or died)
                 return _interpreted_meanwhile(stem, fn, used)
             source = _source(fn)
             if background and len(source) >= BACKGROUND_FROM_BYTES:
-                _write_atomically(source_of(stem), gzip.compress(source.encode(), compresslevel=1))
+                _keep_source(stem, source)
                 return _interpreted_meanwhile(stem, fn, used)
+            if batch is not None:  # built on leaving `built_together`, with the batch's other blocks
+                batch.here.append((source, library))
+                return fn
             _build(source, library, mode)
         except (OSError, subprocess.CalledProcessError):
             return fn
-        if mode == "O0":  # kept for a tier-up (a tenth of the library's size)
-            _write_atomically(source_of(stem), gzip.compress(source.encode(), compresslevel=1))
+        if mode == "O0":  # kept for a tier-up
+            _keep_source(stem, source)
     if tiered and used is not None and source_of(stem).exists():
         used.append(library)
     return ca.external(name, str(library))
@@ -145,9 +192,13 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
 
 def _interpreted_meanwhile(stem: Path, fn: ca.Function, used: list[Path] | None) -> ca.Function:
     """``fn``, interpreted while the block's -O0 library is built from its kept C source in the background (a build
-    under way in this or another process is left to it: `build_later`'s lock), its `interpreted_at` marker appended
-    to ``used``."""
-    build_later(stem, "O0")
+    under way in this or another process is left to it: `build_later`'s lock; inside `built_together`, started on
+    leaving it), its `interpreted_at` marker appended to ``used``."""
+    batch = _BATCH.get()
+    if batch is None:
+        build_later(stem, "O0")
+    elif stem not in batch.later:
+        batch.later.append(stem)
     if used is not None:
         used.append(interpreted_at(stem))
     return fn
@@ -218,7 +269,7 @@ def build_later(stem: Path, level: str, background: bool = True) -> bool:
     source, or another process holds the build's lock. A build that fails keeps its lock, so that it is tried
     again only once the lock is stale (`STALE_LOCK_S`), not after every solve."""
     source, target = source_of(stem), library_at(stem, level)
-    lock = target.with_name(f"{target.name}.lock")
+    lock = _lock_of(target)
     if not source.exists() or not _take(lock):
         return False
     tmp = target.with_name(f"{target.name}.{os.getpid()}.tmp")
@@ -276,6 +327,70 @@ def _source(fn: ca.Function) -> str:
         gen = ca.CodeGenerator(f"{fn.name()}.c", GENERATOR)
         gen.add(fn)
         return Path(gen.generate(tmp + os.sep)).read_text()
+
+
+def _keep_source(stem: Path, source: str) -> None:
+    """Keep a tiered block's C source beside its library, gzipped (a tenth of the library's size), for its
+    background builds."""
+    _write_atomically(source_of(stem), gzip.compress(source.encode(), compresslevel=1))
+
+
+def _build_all(builds: list[tuple[str, Path]], wait_s: float = 120.0) -> None:
+    """Compile each (C source, library) at the level its library's name gives, as many gcc processes at a time as
+    this process may use cores, longest source first; a tiered block's (-O0) source is kept for its tier-up. A
+    library another process is building (its lock: two sweep workers starting on one shape) is waited for, up to
+    ``wait_s`` seconds, not built twice. A build that fails, or is not seen to land, leaves its library missing
+    (the block is then built, or interpreted, where it is next met)."""
+    pending = sorted(((library, source) for library, source in dict((lib, src) for src, lib in builds).items()
+                      if not library.exists()), key=lambda b: -len(b[1]))
+    mine = [(library, source) for library, source in pending if _take(_lock_of(library))]
+    theirs = [library for library, _ in pending if library not in dict(mine)]
+    if mine:
+        cores = max(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 1)
+        with tempfile.TemporaryDirectory(dir=mine[0][0].parent) as tmp:
+            running: list[tuple[subprocess.Popen | None, Path, Path, str]] = []
+            for k, (library, source) in enumerate(mine):
+                c_file, tmp_lib = Path(tmp) / f"fn{k}.c", Path(tmp) / f"{k}_{library.name}"
+                while len(running) >= cores:  # wait for whichever finishes first
+                    done = [b for b in running if b[0] is None or b[0].poll() is not None]
+                    for b in done:
+                        running.remove(b)
+                        _finish(b)
+                    if not done:
+                        time.sleep(0.005)
+                try:
+                    c_file.write_text(source)
+                    process = subprocess.Popen(_compile_command(c_file, tmp_lib, library.name.split(".")[-2]),
+                                               stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                               stderr=subprocess.DEVNULL)
+                except OSError:
+                    process = None
+                running.append((process, tmp_lib, library, source))
+            for build in running:
+                _finish(build)
+    deadline = time.time() + wait_s
+    while theirs and time.time() < deadline:
+        theirs = [lib for lib in theirs if not lib.exists() and _lock_of(lib).exists()]
+        if theirs:
+            time.sleep(0.01)
+
+
+def _finish(build: tuple[subprocess.Popen | None, Path, Path, str]) -> None:
+    """Wait for one of `_build_all`'s gcc processes (None: it could not start), move its library into place and
+    release the library's lock."""
+    process, tmp_lib, library, source = build
+    try:
+        if process is not None and process.wait() == 0 and tmp_lib.exists():
+            os.replace(tmp_lib, library)
+            if library.name.endswith(".O0.so"):
+                _keep_source(_stem(library), source)
+    finally:
+        _lock_of(library).unlink(missing_ok=True)
+
+
+def _lock_of(library: Path) -> Path:
+    """The lock a process holds while it builds ``library`` (`_take`)."""
+    return library.with_name(f"{library.name}.lock")
 
 
 def _build(source: str, library: Path, mode: str) -> None:

@@ -17,7 +17,7 @@ import numpy as np
 
 from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
-from designopt.transcriptions.compiled import compiled, level
+from designopt.transcriptions.compiled import built_together, compiled, level
 from designopt.transcriptions.degeneracy import q_independent_rows
 from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function, block_symbols, per_point
 from designopt.transcriptions.jacobian import (
@@ -265,9 +265,25 @@ class NLP:
         per NLP and compile mode and shared by the solvers of all its profiles."""
         if self.blocks is None:
             return {"x": self.x, "f": self.f, "g": self.g}, {}
+        with built_together() as batch:  # the blocks the cache lacks are compiled together, on leaving
+            pieces = self._pieces(compile_mode)
+        if batch.here:  # made with interpreted stand-ins for them: made again, they load the new libraries
+            self._forget(compile_mode)
+            pieces = self._pieces(compile_mode)
+        return pieces
+
+    def _pieces(self, compile_mode: str) -> tuple[dict, dict]:
         return self._oracle(compile_mode), {"hess_lag": self.hessian(compile_mode),
                                             "jac_g": self.jacobian(compile_mode, values=False),
                                             "grad_f": self.gradient(compile_mode, values=False)}
+
+    def _forget(self, compile_mode: str) -> None:
+        """Drop the functions built under ``compile_mode`` (they are built again on next use)."""
+        for memo in (self._hessians, self._values):
+            memo.pop(compile_mode, None)
+        for memo in (self._jacobians, self._gradients):
+            for values in (False, True):
+                memo.pop((compile_mode, values), None)
 
 
 def _with_value(derivative: ca.Function, value_of: ca.Function) -> ca.Function:
