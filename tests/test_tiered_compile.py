@@ -232,6 +232,33 @@ def test_a_block_another_process_is_building_is_waited_for_not_built_twice(tmp_p
     assert not library.exists() and stuck.exists()
 
 
+def test_an_interrupted_batch_leaves_no_lock_behind(tmp_path, monkeypatch):
+    """A batch interrupted while gcc runs (Ctrl-C) passes the interrupt on and releases the locks of every block it
+    had taken, finished or not: a run started again at once builds them instead of waiting on a dead build."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    x = ca.SX.sym("x", 3)
+    fns = [ca.Function(f"blk4{k}", [x], [ca.cosh(k * x[2]) * ca.sumsqr(x)]) for k in range(3)]
+    with built_together() as batch:
+        monkeypatch.setattr(compiled_module, "_build_all", lambda builds: None)  # noted, not built, on leaving
+        for fn in fns:
+            compiled(fn, "tiered", [])
+    monkeypatch.undo()
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    finished = compiled_module._finish
+
+    def interrupted(build):
+        finished(build)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(compiled_module, "_finish", interrupted)
+    try:
+        compiled_module._build_all(batch.here)
+        raised = False
+    except KeyboardInterrupt:
+        raised = True
+    assert raised and len(batch.here) == 3 and not list(tmp_path.glob("*.lock"))
+
+
 def test_a_large_block_in_a_batch_goes_to_the_background_after_the_batch(tmp_path, monkeypatch):
     """A large block met inside `built_together` is interpreted and reported as before, but its background build
     starts only on leaving, after the batch's own builds; a compiler that fails leaves the batch's blocks

@@ -345,10 +345,29 @@ def _build_all(builds: list[tuple[str, Path]], wait_s: float = 120.0) -> None:
                       if not library.exists()), key=lambda b: -len(b[1]))
     mine = [(library, source) for library, source in pending if _take(_lock_of(library))]
     theirs = [library for library, _ in pending if library not in dict(mine)]
+    running: list[tuple[subprocess.Popen | None, Path, Path, str]] = []
+    try:
+        _run_builds(mine, running)
+    except BaseException:  # interrupted (Ctrl-C): no gcc left running, no lock left for others to wait on
+        for process, *_ in running:
+            if process is not None:
+                process.kill()
+        for library, _ in mine:
+            _lock_of(library).unlink(missing_ok=True)
+        raise
+    deadline = time.time() + wait_s
+    while theirs and time.time() < deadline:
+        theirs = [lib for lib in theirs if not lib.exists() and _lock_of(lib).exists()]
+        if theirs:
+            time.sleep(0.01)
+
+
+def _run_builds(mine: list[tuple[Path, str]], running: list) -> None:
+    """`_build_all`'s own builds: gcc on each (library, source), up to the process's cores at a time, each noted in
+    ``running`` while it runs."""
     if mine:
         cores = max(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 1)
         with tempfile.TemporaryDirectory(dir=mine[0][0].parent) as tmp:
-            running: list[tuple[subprocess.Popen | None, Path, Path, str]] = []
             for k, (library, source) in enumerate(mine):
                 c_file, tmp_lib = Path(tmp) / f"fn{k}.c", Path(tmp) / f"{k}_{library.name}"
                 while len(running) >= cores:  # wait for whichever finishes first
@@ -366,13 +385,9 @@ def _build_all(builds: list[tuple[str, Path]], wait_s: float = 120.0) -> None:
                 except OSError:
                     process = None
                 running.append((process, tmp_lib, library, source))
-            for build in running:
-                _finish(build)
-    deadline = time.time() + wait_s
-    while theirs and time.time() < deadline:
-        theirs = [lib for lib in theirs if not lib.exists() and _lock_of(lib).exists()]
-        if theirs:
-            time.sleep(0.01)
+            while running:
+                _finish(running[0])
+                running.pop(0)
 
 
 def _finish(build: tuple[subprocess.Popen | None, Path, Path, str]) -> None:
