@@ -43,6 +43,13 @@ def _block_terms():
     return ca.Function("terms", [y, s], [phi, pos - s])
 
 
+def _circle_problem(structure: str, waypoints: int):
+    """A small task: a 0.1 m circle of ``waypoints`` waypoints for a generic ``structure`` arm."""
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": waypoints},
+           "robot": {"structure": structure, "dh": "generic"}}
+    return problem_from_config(parse_config(cfg))
+
+
 def test_o0_and_o1_compute_the_same_bits(tmp_path, monkeypatch):
     """A Hessian block at -O0 and at -O1 gives identical doubles at 200 random points, and so does the interpreted
     function (CasADi's virtual machine runs the same IEEE operations in the same order as the generated C)."""
@@ -291,10 +298,7 @@ def test_a_problem_built_cold_loads_a_library_for_every_block(tmp_path, monkeypa
     Hessian of the Lagrangian equals the interpreted one's to the bit."""
     monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
     monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
-    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 5}, "robot": {"structure": "RRR",
-                                                                                    "dh": "generic"}}
-    problem = problem_from_config(parse_config(cfg))
-    nlp = Collocation().build(problem).nlp
+    nlp = Collocation().build(_circle_problem("RRR", 5)).nlp
     _, pieces = nlp.derivatives("auto")
     reported = nlp.tiered_libraries("auto")
     assert reported and all(lib.name.endswith(".O0.so") and lib.exists() for lib in reported)
@@ -387,10 +391,7 @@ def test_a_solve_counts_towards_the_tier_up_and_the_background_build_lands(tmp_p
     next build of the same NLP loads them (nothing left to count)."""
     monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
     monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
-    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 6}, "robot": {"structure": "RR",
-                                                                                    "dh": "generic"}}
-    problem = problem_from_config(parse_config(cfg))
-    nlp = Collocation().build(problem).nlp
+    nlp = Collocation().build(_circle_problem("RR", 6)).nlp
     nlp.derivatives("auto")
     libraries = nlp.tiered_libraries("auto")
     assert len(libraries) >= 4 and all(lib.name.endswith(".O0.so") for lib in libraries)

@@ -341,10 +341,10 @@ def _build_all(builds: list[tuple[str, Path]], wait_s: float = 120.0) -> None:
     library another process is building (its lock: two sweep workers starting on one shape) is waited for, up to
     ``wait_s`` seconds, not built twice. A build that fails, or is not seen to land, leaves its library missing
     (the block is then built, or interpreted, where it is next met)."""
-    pending = sorted(((library, source) for library, source in dict((lib, src) for src, lib in builds).items()
-                      if not library.exists()), key=lambda b: -len(b[1]))
+    missing = {library: source for source, library in builds if not library.exists()}  # each library once
+    pending = sorted(missing.items(), key=lambda b: -len(b[1]))
     mine = [(library, source) for library, source in pending if _take(_lock_of(library))]
-    theirs = [library for library, _ in pending if library not in dict(mine)]
+    theirs = [library for library in missing if library not in dict(mine)]
     running: list[tuple[subprocess.Popen | None, Path, Path, str]] = []
     try:
         _run_builds(mine, running)
@@ -365,29 +365,30 @@ def _build_all(builds: list[tuple[str, Path]], wait_s: float = 120.0) -> None:
 def _run_builds(mine: list[tuple[Path, str]], running: list) -> None:
     """`_build_all`'s own builds: gcc on each (library, source), up to the process's cores at a time, each noted in
     ``running`` while it runs."""
-    if mine:
-        cores = max(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 1)
-        with tempfile.TemporaryDirectory(dir=mine[0][0].parent) as tmp:
-            for k, (library, source) in enumerate(mine):
-                c_file, tmp_lib = Path(tmp) / f"fn{k}.c", Path(tmp) / f"{k}_{library.name}"
-                while len(running) >= cores:  # wait for whichever finishes first
-                    done = [b for b in running if b[0] is None or b[0].poll() is not None]
-                    for b in done:
-                        running.remove(b)
-                        _finish(b)
-                    if not done:
-                        time.sleep(0.005)
-                try:
-                    c_file.write_text(source)
-                    process = subprocess.Popen(_compile_command(c_file, tmp_lib, library.name.split(".")[-2]),
-                                               stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                               stderr=subprocess.DEVNULL)
-                except OSError:
-                    process = None
-                running.append((process, tmp_lib, library, source))
-            while running:
-                _finish(running[0])
-                running.pop(0)
+    if not mine:
+        return
+    cores = max(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 1)
+    with tempfile.TemporaryDirectory(dir=mine[0][0].parent) as tmp:
+        for k, (library, source) in enumerate(mine):
+            c_file, tmp_lib = Path(tmp) / f"fn{k}.c", Path(tmp) / f"{k}_{library.name}"
+            while len(running) >= cores:  # wait for whichever finishes first
+                done = [b for b in running if b[0] is None or b[0].poll() is not None]
+                for b in done:
+                    running.remove(b)
+                    _finish(b)
+                if not done:
+                    time.sleep(0.005)
+            try:
+                c_file.write_text(source)
+                process = subprocess.Popen(_compile_command(c_file, tmp_lib, library.name.split(".")[-2]),
+                                           stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                           stderr=subprocess.DEVNULL)
+            except OSError:
+                process = None
+            running.append((process, tmp_lib, library, source))
+        while running:
+            _finish(running[0])
+            running.pop(0)
 
 
 def _finish(build: tuple[subprocess.Popen | None, Path, Path, str]) -> None:
