@@ -391,7 +391,8 @@ def test_a_solve_counts_towards_the_tier_up_and_the_background_build_lands(tmp_p
     next build of the same NLP loads them (nothing left to count)."""
     monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
     monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
-    nlp = Collocation().build(_circle_problem("RR", 6)).nlp
+    problem = _circle_problem("RR", 6)
+    nlp = Collocation().build(problem).nlp
     nlp.derivatives("auto")
     libraries = nlp.tiered_libraries("auto")
     assert len(libraries) >= 4 and all(lib.name.endswith(".O0.so") for lib in libraries)
