@@ -52,7 +52,8 @@ def setup(config: str, waypoints: int, stage: str, options: tuple = (), compile_
         problem = coarse_problem(problem, waypoints)
     if stage == "explore":  # as the search explores: capped, watched, by the exploration's linear solver
         profile = search.profile.observing("degenerate").capped(search.explore_max_iter)
-        search = replace(search, profile=profile.solved_by(search.explore_linear_solver))
+        search = replace(search, profile=profile.solved_by(search.explore_linear_solver)
+                         .scaled(search.explore_objective_scale))
     if options:
         search = replace(search, profile=replace(search.profile, options=(*search.profile.options, *options)))
     if compile_mode:

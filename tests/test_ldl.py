@@ -221,3 +221,24 @@ def test_the_linear_solver_is_chosen_by_name(monkeypatch):
     monkeypatch.setenv("DESIGNOPT_LINEAR_SOLVER", "ldl")
     monkeypatch.setattr(ldl, "library", lambda: None)
     assert ipopt_backend.linear_solver(SolverProfile()) == "mumps"
+
+
+def test_an_objective_scaled_while_ipopt_iterates_reaches_the_same_optimum_reported_unscaled(monkeypatch):
+    """`SolverProfile.objective_scale`: IPOPT iterates on s x f (``obj_scaling_factor``, set only when s != 1), and
+    the solution it returns is the NLP's own: the gantry's known design cost alpha^2 N / (N - 1) at s = 1 and at s =
+    100 alike. A scale of 0 or below is refused."""
+    monkeypatch.delenv("DESIGNOPT_LINEAR_SOLVER", raising=False)
+    assert "ipopt.obj_scaling_factor" not in ipopt_backend.options(SolverProfile(), 100)
+    assert ipopt_backend.options(SolverProfile().scaled(100), 100)["ipopt.obj_scaling_factor"] == 100.0
+    with pytest.raises(ValueError, match="objective_scale"):
+        SolverProfile(objective_scale=0.0)
+    problem = problem_from_config(parse_config(gantry_config()))
+    N = problem.toolpath.n
+    objectives = []
+    for scale in (1.0, 100.0):
+        sol = solve_from(problem, initial_guesses(problem, 1, 0, 0.3, "constant")[0], max_iter=300,
+                         objective_scale=scale)
+        assert sol.raw.success and sol.metrics.tracks
+        assert sol.metrics.design_cost == pytest.approx(4.0 * N / (N - 1), rel=1e-9)
+        objectives.append(sol.raw.objective)
+    assert objectives[1] == pytest.approx(objectives[0], rel=1e-9)  # reported as the NLP's, not 100x

@@ -481,6 +481,28 @@ def test_the_screen_adds_the_best_of_leaders_whose_starts_it_lacks():
     assert "second-round leaders" not in replace(search, screen_new_leaders=0).describe()
 
 
+def test_only_the_explorations_solves_scale_the_objective():
+    """``explore_objective_scale``: both rounds of the exploration solve with the objective scaled
+    (`SolverProfile.objective_scale`); the screen (as the refine, warm solves alike) solves the NLP's own objective.
+    Driven through the plan; 1 (the field's default) scales nothing and says nothing."""
+    problem = problem_from_config(parse_config({}))
+    a, b = (0, 0, 1, 0, 1), (0, 0, 1, 0, 0)
+    search = Search(starts=4, rebranch=2, seed=2, screen=2, refine=1, explore_objective_scale=30.0)
+    plan = coarse_to_fine.plan([Job("", problem)], search)
+    explore = next(plan)
+    first = [_optimum(problem, cost, form, shift) for cost, form, shift in
+             ((1.0, a, 0.0), (1.5, b, 0.1), (1.8, a, 0.2), (1.9, b, 0.9))]
+    rebranched = plan.send(list(zip(explore, first, strict=True)))
+    assert rebranched and {t.profile.objective_scale for t in explore + rebranched} == {30.0}
+    second = [_optimum(problem, 2.0 + k, a, 0.3 + 0.1 * k) for k in range(len(rebranched))]
+    screen = plan.send(list(zip(rebranched, second, strict=True)))
+    assert {t.stage for t in screen} == {"screen"} and {t.profile.objective_scale for t in screen} == {1.0}
+    assert "the objective scaled by 30" in search.describe()
+    plain = replace(search, explore_objective_scale=1.0)
+    assert {t.profile.objective_scale for t in next(coarse_to_fine.plan([Job("", problem)], plain))} == {1.0}
+    assert "scaled" not in plain.describe()
+
+
 def test_the_second_rounds_leaders_get_their_starts_by_rank():
     """``rebranch_shares``: the second round's leader of rank k starts the k-th entry's number of times, a leader past
     the entries (a new form's) ``rebranch_starts``; the start numbers run on from ``most_starts``, each leader's in a

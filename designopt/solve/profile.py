@@ -27,7 +27,12 @@ class SolverProfile:
     below: `designopt.transcriptions.compiled.level`). ``observers``: names in `designopt.solve.observers.OBSERVERS`,
     watching every iteration; an observer may stop a solve, never change it. ``linear_solver``: what factorises
     the backend's KKT systems, a name in `LINEAR_SOLVERS` (``mumps``: MUMPS with pivoting; ``ldl``: an AMD-ordered
-    LDLᵀ without pivoting, faster and less robust, `designopt.solve.backends.ldl`).
+    LDLᵀ without pivoting, faster and less robust, `designopt.solve.backends.ldl`). ``objective_scale``: the factor
+    the backend multiplies the objective by while it iterates (IPOPT's ``obj_scaling_factor``, on top of its own
+    gradient-based scaling, which caps the objective's largest gradient entry at the start at 100); the objective
+    reported, the observers' and the solution's costs are the NLP's own. A design cost of 1e-4 to 1 weighs little
+    against IPOPT's barrier (0.1 at first) and Hessian perturbation (1e-4 at first): scaled up, the same solve
+    takes fewer and cheaper iterations (`designopt.solve.search.Search`'s ``explore_objective_scale``).
     """
 
     backend: str = "ipopt"
@@ -38,6 +43,7 @@ class SolverProfile:
     observers: tuple[str, ...] = ()
     options: tuple[tuple[str, float | int | str], ...] = ()
     linear_solver: str = "mumps"
+    objective_scale: float = 1.0
 
     def __post_init__(self):
         if self.compile not in COMPILE_MODES:
@@ -46,6 +52,8 @@ class SolverProfile:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got {self.linear_solver!r}")
         if self.max_iter < 1 or self.time_limit <= 0:
             raise ValueError("max_iter must be >= 1 and time_limit > 0")
+        if not self.objective_scale > 0:
+            raise ValueError(f"objective_scale must be > 0, got {self.objective_scale!r}")
 
     def capped(self, max_iter: int | None) -> SolverProfile:
         """The same profile with at most ``max_iter`` iterations (None: unchanged)."""
@@ -57,6 +65,10 @@ class SolverProfile:
     def solved_by(self, linear_solver: str | None) -> SolverProfile:
         """The same profile with another linear solver (None: unchanged)."""
         return self if linear_solver is None else replace(self, linear_solver=linear_solver)
+
+    def scaled(self, objective_scale: float) -> SolverProfile:
+        """The same profile with the objective scaled by ``objective_scale`` while the backend iterates."""
+        return replace(self, objective_scale=float(objective_scale))
 
     def observing(self, *names: str) -> SolverProfile:
         return replace(self, observers=tuple(dict.fromkeys((*self.observers, *names))))

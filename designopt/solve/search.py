@@ -76,8 +76,10 @@ class Search:
     better design (`strategies.neighbours`; problems whose
     structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
     solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None: the
-    profile's; `SolverProfile.linear_solver`); ``screen_linear_solver``: the screen's, each candidate screened once
-    by each of them (and each barrier of ``screen_mu_init``: `screen_passes`). Two settings for a small arm (fewer
+    profile's; `SolverProfile.linear_solver`); ``explore_objective_scale``: the factor the exploration's solves (both
+    rounds) scale the objective by while they iterate (`SolverProfile.objective_scale`; 1: none);
+    ``screen_linear_solver``: the screen's, each candidate screened once by each of them (and each barrier of
+    ``screen_mu_init``: `screen_passes`). Two settings for a small arm (fewer
     than `SMALL_ARM` moving joints, `small_arm`): ``small_arm_screens_once``, its candidates screened by the first
     of those passes only (a small arm's passes end in one basin; `passes_for`); ``small_arm_perturbation``, the
     ``perturbation`` of its exploration's seeded starts (None: ``perturbation``; `perturbation_for`).
@@ -142,6 +144,7 @@ class Search:
     structure_neighbours: bool = True
     profile: SolverProfile = field(default_factory=SolverProfile)
     explore_linear_solver: str | None = None
+    explore_objective_scale: float = 1.0
     screen_linear_solver: tuple[str | None, ...] = (None,)
     screen_mu_init: tuple[float | None, ...] = (None,)
     small_arm_screens_once: bool = False
@@ -354,6 +357,8 @@ class Search:
         again = (f", the best {self.rebranch} distinct{per_form} restarted {times} on a new joint branch"
                  if self.rebranch else "")
         kkt = self._kkt((self.explore_linear_solver,))
+        if self.explore_objective_scale != 1.0:
+            kkt += f", the objective scaled by {self.explore_objective_scale:g}"
         barrier = _barriers(self.refine_mu_init)
         if self.refine_from_coarse and self.screen:
             barrier += ", and once from its coarse optimum"

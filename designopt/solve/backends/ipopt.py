@@ -76,6 +76,8 @@ def options(profile, n_variables: int = 0) -> dict:
             opts["ipopt.mumps_pivot_order"] = 5
         if n_variables >= BOUNDED_PERTURBATION_FROM:
             opts["ipopt.max_hessian_perturbation"] = 1e8
+    if profile.objective_scale != 1.0:
+        opts["ipopt.obj_scaling_factor"] = float(profile.objective_scale)
     return {**opts, **(WARM_OPTIONS if profile.warm else {}), **dict(profile.options)}
 
 
