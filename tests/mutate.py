@@ -776,6 +776,15 @@ MUTATIONS = [
              "watched = search.profile.observing(STALLED) if", "watched = None if", ("tests/test_search.py",)),
     Mutation("the backend does not hand a solve's bound to its observers",
              "designopt/solve/backends/ipopt.py", "o.reset(bound)", "o.reset()", ("tests/test_search.py",)),
+    Mutation("a profile's objective scale never reaches IPOPT", "designopt/solve/backends/ipopt.py",
+             'opts["ipopt.obj_scaling_factor"] = float(profile.objective_scale)', "pass", ("tests/test_ldl.py",)),
+    Mutation("the exploration solves the objective unscaled",
+             "designopt/solve/strategies/coarse_to_fine.py",
+             "\n                   .scaled(search.explore_objective_scale))", ")", ("tests/test_search.py",)),
+    Mutation("every stage scales the objective as the exploration does",
+             "designopt/solve/strategies/coarse_to_fine.py",
+             "warm = search.profile.warmed()", "warm = search.profile.scaled(search.explore_objective_scale).warmed()",
+             ("tests/test_search.py",)),
 ]
 
 

@@ -241,4 +241,4 @@ def test_an_objective_scaled_while_ipopt_iterates_reaches_the_same_optimum_repor
         assert sol.raw.success and sol.metrics.tracks
         assert sol.metrics.design_cost == pytest.approx(4.0 * N / (N - 1), rel=1e-9)
         objectives.append(sol.raw.objective)
-    assert objectives[1] == pytest.approx(objectives[0], rel=1e-9)  # reported as the NLP's, not 100x
+    assert objectives[1] == pytest.approx(objectives[0], rel=1e-6)  # reported as the NLP's, not 100x
