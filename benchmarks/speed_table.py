@@ -51,9 +51,7 @@ def setup(config: str, waypoints: int, stage: str, options: tuple = (), compile_
     if waypoints:
         problem = coarse_problem(problem, waypoints)
     if stage == "explore":  # as the search explores: capped, watched, by the exploration's linear solver
-        profile = search.profile.observing("degenerate").capped(search.explore_max_iter)
-        search = replace(search, profile=profile.solved_by(search.explore_linear_solver)
-                         .scaled(search.explore_objective_scale))
+        search = replace(search, profile=search.explore_profile.observing("degenerate"))
     if options:
         search = replace(search, profile=replace(search.profile, options=(*search.profile.options, *options)))
     if compile_mode:

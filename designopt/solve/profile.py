@@ -31,8 +31,9 @@ class SolverProfile:
     the backend multiplies the objective by while it iterates (IPOPT's ``obj_scaling_factor``, on top of its own
     gradient-based scaling, which caps the objective's largest gradient entry at the start at 100); the objective
     reported, the observers' and the solution's costs are the NLP's own. A design cost of 1e-4 to 1 weighs little
-    against IPOPT's barrier (0.1 at first) and Hessian perturbation (1e-4 at first): scaled up, the same solve
-    takes fewer and cheaper iterations (`designopt.solve.search.Search`'s ``explore_objective_scale``).
+    against IPOPT's barrier (0.1 at first) and Hessian perturbation (1e-4 at first): scaled up, a solve takes fewer
+    and cheaper iterations but settles sooner, often in a worse basin (judged on the exploration, not adopted:
+    `designopt.solve.search.Search`'s ``explore_objective_scale``, docs/decisions.md).
     """
 
     backend: str = "ipopt"

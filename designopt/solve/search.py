@@ -169,6 +169,13 @@ class Search:
         """The seeds of the ``draws`` independent draws: ``seed``, then ``seed`` + k x `DRAW_STRIDE`."""
         return [self.seed + k * DRAW_STRIDE for k in range(self.draws)]
 
+    @property
+    def explore_profile(self) -> SolverProfile:
+        """How the exploration's solves (both rounds) are solved: the profile capped at ``explore_max_iter``, by
+        ``explore_linear_solver``, the objective scaled by ``explore_objective_scale``."""
+        return (self.profile.capped(self.explore_max_iter).solved_by(self.explore_linear_solver)
+                .scaled(self.explore_objective_scale))
+
     def drawn(self) -> list[Search]:
         """The ``draws`` independent draws, each this search of one draw with its seed (`draw_seeds`)."""
         return [replace(self, seed=seed, draws=1) for seed in self.draw_seeds]

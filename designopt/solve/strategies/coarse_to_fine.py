@@ -215,9 +215,7 @@ def plan(jobs, search):
     explore = []
     for job, starts in zip(jobs, exploration_starts([job.problem for job in jobs], search), strict=True):
         coarse = coarse_problem(job.problem, search.explore_waypoints)
-        profile = (search.profile.capped(search.explore_max_iter).solved_by(search.explore_linear_solver)
-                   .scaled(search.explore_objective_scale))
-        explore += seeded_tasks(job, "explore", coarse, profile, search, starts)
+        explore += seeded_tasks(job, "explore", coarse, search.explore_profile, search, starts)
     explored = by_job(jobs, (yield explore))
     if search.rebranch:
         for r in range(search.rebranch_rounds):  # each round from the best distinct optima of every round before it
