@@ -54,7 +54,9 @@ def strip(run: Path, start: str) -> int:
     for name in summary.loc[drop, "solution_file"].dropna():
         (run / str(name)).unlink(missing_ok=True)
     summary.loc[~drop].to_csv(run / "summary.csv", index=False)
-    for name in ("best.json", "solution_set.csv"):
+    # search.json too: the copy is finished by this checkout's search (a variant's), and `designopt run --resume`
+    # refuses a run whose recorded search is another; the kept stages' solves stay the run's own
+    for name in ("best.json", "solution_set.csv", "search.json"):
         (run / name).unlink(missing_ok=True)
     return int(drop.sum())
 
