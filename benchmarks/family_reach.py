@@ -58,10 +58,11 @@ def start_kind(search, number: int) -> str:
     offset = index - search.leader_start(r, rank)
     if offset < search.leader_drawn:
         return "drawn"
-    for block, (count, size, perturbation) in enumerate(search.more_blocks):
+    for block, (count, size, perturbation, snapped) in enumerate(search.more_blocks):
         begin = search.more_start(block, r, rank) - search.leader_start(r, rank)
         if count > 0 and begin <= offset < begin + size:
-            return "extra" if not perturbation else f"moved by {perturbation:g}"
+            kind = "extra" if not perturbation else f"moved by {perturbation:g}"
+            return f"{kind}, snapped" if snapped else kind
     return "other"
 
 

@@ -28,6 +28,7 @@ from designopt.initial_guess import (
     initial_guess,
     projected,
     residual_function,
+    snapped_design,
     start_index,
     start_number,
 )
@@ -724,6 +725,67 @@ def test_extra_starts_moved_around_their_leaders_design():
     for t in kept:
         assert np.array_equal(t.start.design(coarse), np.asarray(t.start.solution.raw.q_d, float))
     assert "with the design perturbed by 0.05" in moved.describe() and "perturbed by" not in extra.describe()
+
+
+def test_a_snapped_design_has_its_arms_angles_on_the_lattice_and_nothing_else_moved():
+    """`snapped_design`: every design angle of the arm (the DH twists here) at its nearest multiple of pi/2; the
+    lengths and the placement's angles exactly as given; within bounds; snapping twice changes nothing."""
+    problem = problem_from_config(parse_config({}))
+    chain = problem.chain
+    placement = {j.name for j in chain.placement_joints}
+    arm_angle = np.array([j.kind == "angle" and j.name not in placement for j in chain.design])
+    assert arm_angle.sum() == 6 and not arm_angle[[j.name for j in chain.design].index("placement.yaw")]
+    rng = np.random.default_rng(3)
+    lower, upper = np.array([j.lower for j in chain.design]), np.array([j.upper for j in chain.design])
+    for _ in range(20):
+        q = np.clip(chain.design_values + rng.uniform(-0.7, 0.7, chain.n_design), lower, upper)
+        snapped = snapped_design(problem, q)
+        assert np.array_equal(snapped[~arm_angle], q[~arm_angle])
+        quarter = snapped[arm_angle] / (np.pi / 2)
+        assert np.allclose(quarter, np.rint(quarter), atol=1e-12)
+        assert np.all(np.abs(snapped[arm_angle] - q[arm_angle]) <= np.pi / 4 + 1e-12)
+        assert np.all((lower <= snapped) & (snapped <= upper))
+        assert np.array_equal(snapped_design(problem, snapped), snapped)
+
+
+def test_extra_starts_from_their_leaders_design_snapped():
+    """``rebranch_extra_snap``: a leader's extra starts start from its design with the arm's angles snapped
+    (`snapped_design`), its drawn starts from its design as it is; the extras are spread over the branches with
+    the snapped design's walks (`first_configuration` is each one's walk's first row, to the bit). Off: as before."""
+    problem, coarse, sols, task = _two_leaders()
+    joints = [j.name for j in coarse.chain.design]
+    for sol in sols:  # twists a few tenths off the lattice, the placement turned: what snapping must tell apart
+        sol.raw.q_d = sol.raw.q_d.copy()
+        sol.raw.q_d[joints.index("link4.alpha")] += 0.2
+        sol.raw.q_d[joints.index("link2.alpha")] -= 0.15
+        sol.raw.q_d[joints.index("placement.yaw")] += 0.3
+    extra = Search(starts=6, rebranch=2, seed=4, init="home", rebranch_extra=2, rebranch_extra_pool=5)
+    snap = replace(extra, rebranch_extra_snap=True)
+    assert snap.more_blocks[0] == (2, 5, 0.0, True) and extra.more_blocks[0] == (2, 5, 0.0, False)
+    kept = rebranched_tasks([[(task, s) for s in sols]], extra)
+    after = rebranched_tasks([[(task, s) for s in sols]], snap)
+    angle = np.array([j.kind == "angle" for j in coarse.chain.moving])
+    for k, leader in enumerate(sols):
+        mine = after[5 * k:5 * k + 5]
+        q_d = np.asarray(leader.raw.q_d, float)
+        assert [t.start.index for t in mine[:3]] == [t.start.index for t in kept[5 * k:5 * k + 3]]
+        for t in mine[:3]:
+            assert np.array_equal(t.start.guess(coarse).q_d, q_d)
+        for t in mine[3:]:
+            guess = t.start.guess(coarse)
+            assert np.array_equal(guess.q_d, snapped_design(coarse, q_d)) and not np.allclose(guess.q_d, q_d)
+            assert guess.q_d[joints.index("placement.yaw")] == q_d[joints.index("placement.yaw")]
+            assert np.array_equal(t.start.first_configuration(coarse), guess.Q[0])
+        begin = snap.more_start(0, 0, k)
+        pool = [Rebranched(leader, 4, j, "home", 0.0, True) for j in range(begin, begin + 5)]
+        firsts = np.array([t.start.first_configuration(coarse) for t in mine[:3]] +
+                          [s.first_configuration(coarse) for s in pool])
+        chosen = spread_branches(firsts, 5, angle, kept=3)[3:]
+        assert [t.start.index for t in mine[3:]] == sorted(begin + j - 3 for j in chosen)
+    for t in kept:
+        assert np.array_equal(t.start.design(coarse), np.asarray(t.start.solution.raw.q_d, float))
+    assert "arm's angles at the nearest multiple of pi/2" in snap.describe()
+    assert "nearest multiple" not in extra.describe()
 
 
 def test_a_later_round_on_new_joint_branches_starts_from_the_best_of_every_round_before_it():

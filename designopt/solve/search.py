@@ -55,7 +55,9 @@ class Search:
     the path's first waypoint, `starts.spread_branches`; ``rebranch_extra`` > 0: that many starts more per leader,
     spread over the branches its drawn ones miss, out of ``rebranch_extra_pool`` drawn in a block of their own,
     `more_start`; ``rebranch_extra_perturbation`` > 0: those with the design moved around the leader's by that
-    scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`; ``rebranch_moved`` > 0: that many starts
+    scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`; ``rebranch_extra_snap``: those from the
+    leader's design with its arm's angles (twists) at the nearest multiple of pi/2, the idealised arm of its form
+    (`initial_guess.snapped_design`), before any move; ``rebranch_moved`` > 0: that many starts
     more again per leader, their designs moved around the leader's by ``rebranch_moved_perturbation``, spread over
     the branches all the leader's other starts miss, out of ``rebranch_moved_pool`` drawn in a block of their own,
     `more_start`; both are `more_blocks`); the
@@ -126,6 +128,7 @@ class Search:
     rebranch_extra: int = 0
     rebranch_extra_pool: int = 40
     rebranch_extra_perturbation: float = 0.0
+    rebranch_extra_snap: bool = False
     rebranch_moved: int = 0
     rebranch_moved_pool: int = 20
     rebranch_moved_perturbation: float = 0.1
@@ -216,13 +219,14 @@ class Search:
         return self.rebranch + self.rebranch_new_forms
 
     @property
-    def more_blocks(self) -> tuple[tuple[int, int, float], ...]:
+    def more_blocks(self) -> tuple[tuple[int, int, float, bool], ...]:
         """The blocks of starts more per leader of a round on new joint branches, beside its drawn ones, in the
         order they join them and are numbered (`more_start`): (how many, out of how many drawn, the scale the
-        design is moved by: `starts.Rebranched`) for the extras (``rebranch_extra``), then the moved starts
-        (``rebranch_moved``)."""
-        return ((self.rebranch_extra, self.rebranch_extra_pool, self.rebranch_extra_perturbation),
-                (self.rebranch_moved, self.rebranch_moved_pool, self.rebranch_moved_perturbation))
+        design is moved by, whether the leader's arm angles are snapped first: `starts.Rebranched`) for the extras
+        (``rebranch_extra``), then the moved starts (``rebranch_moved``)."""
+        return ((self.rebranch_extra, self.rebranch_extra_pool, self.rebranch_extra_perturbation,
+                 self.rebranch_extra_snap),
+                (self.rebranch_moved, self.rebranch_moved_pool, self.rebranch_moved_perturbation, False))
 
     @property
     def leader_drawn(self) -> int:
@@ -234,7 +238,7 @@ class Search:
     def leader_width(self) -> int:
         """The start indices one leader takes in one round on new joint branches: its drawn starts
         (`leader_drawn`), then the pool of every block of `more_blocks` that adds any start."""
-        return self.leader_drawn + sum(size for count, size, _ in self.more_blocks if count > 0)
+        return self.leader_drawn + sum(size for count, size, *_ in self.more_blocks if count > 0)
 
     def leader_start(self, r: int, rank: int) -> int:
         """The first start index of round ``r``'s leader of ``rank`` (0: the cheapest) on new joint branches, the
@@ -247,7 +251,7 @@ class Search:
         """The first start index of the pool drawn for block ``block`` of `more_blocks` for round ``r``'s leader
         of ``rank``: in that leader's block (`leader_start`), after its drawn starts and the pools of the earlier
         blocks that add any start."""
-        earlier = sum(size for count, size, _ in self.more_blocks[:block] if count > 0)
+        earlier = sum(size for count, size, *_ in self.more_blocks[:block] if count > 0)
         return self.leader_start(r, rank) + self.leader_drawn + earlier
 
     def hop_start(self, rank: int) -> int:
@@ -356,6 +360,8 @@ class Search:
         if self.rebranch_extra:
             times += (f" and {self.rebranch_extra} more spread over the branches those miss (of "
                       f"{self.rebranch_extra_pool} drawn)")
+            if self.rebranch_extra_snap:
+                times += " from the leader's design with its arm's angles at the nearest multiple of pi/2"
             if self.rebranch_extra_perturbation:
                 times += f" with the design perturbed by {self.rebranch_extra_perturbation:g}"
         if self.rebranch_moved:

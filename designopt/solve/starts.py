@@ -21,6 +21,7 @@ from designopt.initial_guess import (
     initial_guess,
     perturbed_design,
     projected,
+    snapped_design,
     start_number,
 )
 from designopt.kinematics.chain import placement_pose
@@ -80,19 +81,25 @@ class Rebranched(Numbered):
     IK (``init``). A design's best basin is often on a branch its own start never visits (a folded posture, the
     tool near every joint axis): the design and its branch have to be found together. With ``perturbation`` > 0
     the design is moved around the optimum's too (`design`): a restart near it, for the better optima of its form
-    that lie a few centimetres or a fraction of a radian away."""
+    that lie a few centimetres or a fraction of a radian away. With ``snapped`` the optimum's arm angles are first
+    set to their nearest multiple of pi/2 (`initial_guess.snapped_design`): the idealised arm of its form, whose
+    best basin a coarse optimum with twists a few tenths of a radian off the lattice may not be in."""
 
     solution: object  # designopt.solution.Solution
     seed: int
     index: int
     init: str = "ik"
     perturbation: float = 0.0
+    snapped: bool = False
 
     def design(self, problem: DesignProblem) -> np.ndarray:
-        """The start's design joints: the optimum's, plus uniform noise of ``perturbation`` x 0.5 m for lengths and
-        x pi rad for angles (`initial_guess.perturbed_design`, drawn from (seed, index) apart from the first
-        configuration's draw), clipped to their bounds; the optimum's own when ``perturbation`` is 0."""
+        """The start's design joints: the optimum's (``snapped``: with its arm angles at their nearest multiple of
+        pi/2), plus uniform noise of ``perturbation`` x 0.5 m for lengths and x pi rad for angles
+        (`initial_guess.perturbed_design`, drawn from (seed, index) apart from the first configuration's draw),
+        clipped to their bounds; without noise when ``perturbation`` is 0."""
         q_d = np.asarray(self.solution.raw.q_d, float)
+        if self.snapped:
+            q_d = snapped_design(problem, q_d)
         if not self.perturbation:
             return q_d
         return perturbed_design(problem, np.random.default_rng([self.seed, self.index, 1]), self.perturbation, q_d)

@@ -188,15 +188,15 @@ def rebranched_tasks(found, search, round_: int = 0) -> list[Task]:
             drawn = range(index, index + n * search.rebranch_pool)
             pool = [Rebranched(sol, search.seed, j, search.init) for j in drawn]
             angle = np.array([joint.kind == "angle" for joint in first.problem.chain.moving], dtype=bool)
-            if search.rebranch_pool > 1 or any(count > 0 for count, _, _ in search.more_blocks):
+            if search.rebranch_pool > 1 or any(count > 0 for count, *_ in search.more_blocks):
                 firsts = first_configurations_of(first.problem, pool)
             if search.rebranch_pool > 1:
                 chosen = sorted(spread_branches(firsts, n, angle))
                 pool, firsts = [pool[j] for j in chosen], firsts[chosen]
-            for block, (count, size, perturbation) in enumerate(search.more_blocks):
+            for block, (count, size, perturbation, snapped) in enumerate(search.more_blocks):
                 if count > 0:
                     begin = search.more_start(block, round_, k)
-                    more = [Rebranched(sol, search.seed, j, search.init, perturbation)
+                    more = [Rebranched(sol, search.seed, j, search.init, perturbation, snapped)
                             for j in range(begin, begin + size)]
                     pool, firsts = _spread_more(pool, firsts, more, count, angle, first.problem)
             tasks += [replace(first, start=start) for start in pool]
