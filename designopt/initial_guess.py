@@ -37,18 +37,6 @@ def perturbed_design(problem: DesignProblem, rng: np.random.Generator, scale: fl
     return within_bounds(problem, centre + noise * step)
 
 
-def snapped_design(problem: DesignProblem, q_d: np.ndarray) -> np.ndarray:
-    """Design joints with the arm's angles -- every design angle but the placement's: DH twists, a URDF joint
-    origin's angles -- at their nearest multiple of pi/2 (rad), within bounds; lengths and placement as given. The
-    idealised arm of a design's form (`designopt.solve.optima.design_forms`): consecutive joint axes exactly
-    parallel or perpendicular where the design has them nearly so."""
-    placement = {j.name for j in problem.chain.placement_joints}
-    lattice = np.array([j.kind == "angle" and j.name not in placement for j in problem.chain.design], dtype=bool)
-    q = np.array(q_d, dtype=float)
-    q[lattice] = np.round(q[lattice] / (np.pi / 2)) * (np.pi / 2)
-    return within_bounds(problem, q)
-
-
 def within_bounds(problem: DesignProblem, q_d: np.ndarray) -> np.ndarray:
     """Design joint values clipped to their bounds."""
     joints = problem.chain.design

@@ -28,7 +28,6 @@ from designopt.initial_guess import (
     initial_guess,
     projected,
     residual_function,
-    snapped_design,
     start_index,
     start_number,
 )
@@ -50,7 +49,7 @@ from designopt.solve import (
     solve_guess,
     solve_one,
 )
-from designopt.solve.optima import arm_joints, cluster_designs, design_forms, form_joints
+from designopt.solve.optima import arm_joints, cluster_designs, design_forms, form_joints, snapped_design
 from designopt.solve.search import DRAW_STRIDE
 from designopt.solve.starts import Rebranched, first_configurations_of, spread_branches
 from designopt.solve.strategies import _drive, coarse_to_fine, hop, reflect
@@ -739,13 +738,13 @@ def test_a_snapped_design_has_its_arms_angles_on_the_lattice_and_nothing_else_mo
     lower, upper = np.array([j.lower for j in chain.design]), np.array([j.upper for j in chain.design])
     for _ in range(20):
         q = np.clip(chain.design_values + rng.uniform(-0.7, 0.7, chain.n_design), lower, upper)
-        snapped = snapped_design(problem, q)
+        snapped = snapped_design(chain, q)
         assert np.array_equal(snapped[~arm_angle], q[~arm_angle])
         quarter = snapped[arm_angle] / (np.pi / 2)
         assert np.allclose(quarter, np.rint(quarter), atol=1e-12)
         assert np.all(np.abs(snapped[arm_angle] - q[arm_angle]) <= np.pi / 4 + 1e-12)
         assert np.all((lower <= snapped) & (snapped <= upper))
-        assert np.array_equal(snapped_design(problem, snapped), snapped)
+        assert np.array_equal(snapped_design(chain, snapped), snapped)
 
 
 def test_extra_starts_from_their_leaders_design_snapped():
@@ -773,7 +772,7 @@ def test_extra_starts_from_their_leaders_design_snapped():
             assert np.array_equal(t.start.guess(coarse).q_d, q_d)
         for t in mine[3:]:
             guess = t.start.guess(coarse)
-            assert np.array_equal(guess.q_d, snapped_design(coarse, q_d)) and not np.allclose(guess.q_d, q_d)
+            assert np.array_equal(guess.q_d, snapped_design(coarse.chain, q_d)) and not np.allclose(guess.q_d, q_d)
             assert guess.q_d[joints.index("placement.yaw")] == q_d[joints.index("placement.yaw")]
             assert np.array_equal(t.start.first_configuration(coarse), guess.Q[0])
         begin = snap.more_start(0, 0, k)

@@ -85,6 +85,17 @@ def arm_joints(chain) -> np.ndarray:
     return np.array([i not in placement for i in design], dtype=bool)
 
 
+def snapped_design(chain, q_d: np.ndarray) -> np.ndarray:
+    """Design joints with the arm's angles (`arm_joints` of kind angle: DH twists, a URDF joint origin's angles) at
+    their nearest multiple of pi/2 (rad), within bounds; lengths and placement as given. The idealised arm of a
+    design's form (`design_forms`): consecutive joint axes exactly parallel or perpendicular where the design has
+    them nearly so."""
+    lattice = arm_joints(chain) & np.array([j.kind == "angle" for j in chain.design], dtype=bool)
+    q = np.array(q_d, dtype=float)
+    q[lattice] = np.round(q[lattice] / (np.pi / 2)) * (np.pi / 2)
+    return np.clip(q, [j.lower for j in chain.design], [j.upper for j in chain.design])
+
+
 def design_forms(designs: np.ndarray, form: np.ndarray) -> list[tuple[int, ...]]:
     """Each design's form: its design angles marked in ``form`` (`form_joints`), each 0 near a multiple of pi
     (consecutive joint axes parallel, for a twist) or 1 near an odd multiple of pi/2 (perpendicular) -- the

@@ -57,7 +57,7 @@ class Search:
     `more_start`; ``rebranch_extra_perturbation`` > 0: those with the design moved around the leader's by that
     scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`; ``rebranch_extra_snap``: those from the
     leader's design with its arm's angles (twists) at the nearest multiple of pi/2, the idealised arm of its form
-    (`initial_guess.snapped_design`), before any move; ``rebranch_moved`` > 0: that many starts
+    (`optima.snapped_design`), before any move; ``rebranch_moved`` > 0: that many starts
     more again per leader, their designs moved around the leader's by ``rebranch_moved_perturbation``, spread over
     the branches all the leader's other starts miss, out of ``rebranch_moved_pool`` drawn in a block of their own,
     `more_start`; both are `more_blocks`); the

@@ -21,7 +21,6 @@ from designopt.initial_guess import (
     initial_guess,
     perturbed_design,
     projected,
-    snapped_design,
     start_number,
 )
 from designopt.kinematics.chain import placement_pose
@@ -30,6 +29,7 @@ from designopt.kinematics.reflections import Reflection
 from designopt.kinematics.transforms import dh_transform, inverse
 from designopt.kinematics.urdf import rpy_of
 from designopt.problem import DesignProblem
+from designopt.solve.optima import snapped_design
 from designopt.transcriptions.base import InitialGuess
 
 
@@ -82,7 +82,7 @@ class Rebranched(Numbered):
     tool near every joint axis): the design and its branch have to be found together. With ``perturbation`` > 0
     the design is moved around the optimum's too (`design`): a restart near it, for the better optima of its form
     that lie a few centimetres or a fraction of a radian away. With ``snapped`` the optimum's arm angles are first
-    set to their nearest multiple of pi/2 (`initial_guess.snapped_design`): the idealised arm of its form, whose
+    set to their nearest multiple of pi/2 (`optima.snapped_design`): the idealised arm of its form, whose
     best basin a coarse optimum with twists a few tenths of a radian off the lattice may not be in."""
 
     solution: object  # designopt.solution.Solution
@@ -99,7 +99,7 @@ class Rebranched(Numbered):
         clipped to their bounds; without noise when ``perturbation`` is 0."""
         q_d = np.asarray(self.solution.raw.q_d, float)
         if self.snapped:
-            q_d = snapped_design(problem, q_d)
+            q_d = snapped_design(problem.chain, q_d)
         if not self.perturbation:
             return q_d
         return perturbed_design(problem, np.random.default_rng([self.seed, self.index, 1]), self.perturbation, q_d)
