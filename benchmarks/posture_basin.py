@@ -49,8 +49,8 @@ def main() -> None:
     parser.add_argument("--noisy", type=int, default=8)
     parser.add_argument("--seed", type=int, default=900, help="the branches' seed (their start numbers)")
     args = parser.parse_args()
-    problem = problem_from_config(load_config(ROOT / args.config))
-    search = search_from_config(load_config(ROOT / args.config))
+    cfg = load_config(ROOT / args.config)
+    problem, search = problem_from_config(cfg), search_from_config(cfg)
     best = read_solution_for(problem, Collocation(), ROOT / args.reference)
     known, q_d = best.metrics.design_cost, np.asarray(best.raw.q_d, float)
     first = best.sample(problem.toolpath.t)[0]
