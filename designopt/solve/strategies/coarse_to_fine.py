@@ -45,7 +45,7 @@ import numpy as np
 from designopt.problem import DesignProblem
 from designopt.solve.optima import best_solution, distinct_best
 from designopt.solve.search import Searched, by_job
-from designopt.solve.starts import Lifted, Rebranched, first_configurations_of, spread_branches
+from designopt.solve.starts import Lifted, Rebranched, first_configurations_of, lifted_guess, spread_branches
 from designopt.solve.strategies.steps import numbered_stage, seeded_tasks, solve_setup
 from designopt.solve.tasks import Task
 from designopt.toolpaths import subsample
@@ -120,6 +120,18 @@ def lifted(job, solutions, stage: str, waypoints: int | None, search, max_iter: 
     problem = job.problem if waypoints is None else coarse_problem(job.problem, waypoints)
     profile, continuation = solve_setup(job, search, warm)
     return [Task(job.case, stage, problem, job.transcription, profile, Lifted(sol), continuation) for sol in solutions]
+
+
+def step_ratio(problem: DesignProblem, solution) -> float:
+    """The largest joint step of ``solution`` lifted to ``problem``'s path (`lifted_guess`) over what the velocity
+    limits allow between its waypoints (v_max h): above 1, no trajectory within the limits starts there."""
+    guess = lifted_guess(problem, solution)
+    return float((np.abs(np.diff(guess.Q, axis=0)) / problem.max_steps).max())
+
+
+def relaxed_problem(problem: DesignProblem, scale: float) -> DesignProblem:
+    """``problem`` with every joint's velocity limit (rad/s or m/s) times ``scale``."""
+    return replace(problem, joint_velocity=tuple(float(v) for v in problem.velocity_limits * scale))
 
 
 def coarse_optima(explored, refined) -> list:
@@ -255,10 +267,26 @@ def plan(jobs, search):
     chosen = [[done[i][1] for i in picked(done, search.refine, search)] for done in candidates]
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init) for job, sols in zip(jobs, chosen, strict=True)
                for task in lifted(job, sols, numbered_stage("refine", i), None, search, mu_init=refine_mu)]
+    passes = len(search.refine_mu_init)
     if search.refine_from_coarse:  # each refined candidate refined again from its coarse optimum
-        stage = numbered_stage("refine", len(search.refine_mu_init))
+        stage = numbered_stage("refine", passes)
+        passes += 1
         for k in screened:
             refines += lifted(jobs[k], coarse_optima(explored[k], chosen[k]), stage, None, search)
+    if search.refine_relaxed:  # and through velocity limits relaxed to fit its lifted start
+        ratios = [[step_ratio(job.problem, sol) for sol in sols] for job, sols in zip(jobs, chosen, strict=True)]
+        relaxed = [(k, sol, r) for k, (sols, rs) in enumerate(zip(chosen, ratios, strict=True))
+                   for sol, r in zip(sols, rs, strict=True) if r > 1.0]
+        done = []
+        for i, exponent in enumerate((1.0, 0.5)):
+            tasks = [lifted(replace(jobs[k], problem=relaxed_problem(jobs[k].problem, (1.05 * r) ** exponent)),
+                            [sol], numbered_stage("relax", i), None, search, mu_init=None if i == 0 else 1e-6)[0]
+                     for (k, _, r), sol in zip(relaxed, done or [sol for _, sol, _ in relaxed], strict=True)]
+            solved = {task.key: sol for task, sol in (yield tasks)}
+            done = [solved[task.key] for task in tasks]
+        stage = numbered_stage("refine", passes)
+        refines += [lifted(jobs[k], [sol], stage, None, search, mu_init=1e-6)[0]
+                    for (k, _, _), sol in zip(relaxed, done, strict=True)]
     final = by_job(jobs, (yield refines))
     return [Searched(job, e, f) for job, e, f in zip(jobs, explored, final, strict=True)]
 
