@@ -62,7 +62,7 @@ from designopt.solve.strategies.coarse_to_fine import (
 from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import units
 from designopt.toolpaths import figure_eight, subsample
-from designopt.transcriptions import Collocation
+from designopt.transcriptions import Collocation, InitialGuess
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -1146,6 +1146,67 @@ def test_refine_from_coarse_refines_each_refined_candidate_again_from_its_coarse
     _, screened, refine = refines(replace(search, refine_from_coarse=False))
     assert [t.stage for t in refine] == ["refine", "refine", "refine2", "refine2"]
     assert "from its coarse optimum" not in replace(search, refine_from_coarse=False).describe()
+
+def test_refine_relaxed_refines_a_candidate_whose_lift_steps_too_far_through_relaxed_velocity_limits(monkeypatch):
+    """`Search.refine_relaxed`: each refined candidate whose lifted start steps beyond the velocity limits (r > 1,
+    `step_ratio`) is solved warm with the limits x 1.05 r (stage ``relax``), from that solution with x sqrt(1.05 r)
+    and barrier 1e-6 (``relax2``), then at the problem's own limits from 1e-6 in the stage after the refine's
+    passes; a candidate whose lift fits the limits gets no such pass; the relaxed solves are not in the answers.
+    Driven through the plan, the step ratios given."""
+    problem = problem_from_config(parse_config({}))
+    a = (0, 0, 1, 0, 1)
+    job = Job("", problem)
+    search = Search(starts=6, rebranch=0, screen=3, screen_waypoints=20, refine=2, refine_mu_init=(None, 1e-6),
+                    refine_relaxed=True)
+    plan = coarse_to_fine.plan([job], search)
+    explore = next(plan)
+    sols = _numbered_optima(problem, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0], a, [t.seed for t in explore])
+    screen = plan.send(list(zip(explore, sols, strict=True)))
+    screened = _numbered_optima(problem, [2.5, 9.0, 0.5], a, [t.seed for t in screen])
+    ratios = {id(screened[2]): 4.0, id(screened[0]): 0.7}  # the refine takes the 3rd (cheapest), then the 1st
+    monkeypatch.setattr(coarse_to_fine, "step_ratio", lambda _, sol: ratios[id(sol)])
+    relax = plan.send(list(zip(screen, screened, strict=True)))
+    assert [(t.stage, t.start.solution) for t in relax] == [("relax", screened[2])]
+    limits = problem.velocity_limits
+    assert np.allclose(relax[0].problem.velocity_limits, 4.2 * limits)
+    assert relax[0].problem.toolpath is problem.toolpath  # the full path, the same task
+    assert dict(relax[0].profile.options).get("ipopt.mu_init") == dict(
+        coarse_to_fine.lifted(job, screened[:1], "refine", None, search)[0].profile.options).get("ipopt.mu_init")
+    first = _numbered_optima(problem, [0.4], a, [relax[0].seed])
+    relax2 = plan.send(list(zip(relax, first, strict=True)))
+    assert [(t.stage, t.start.solution) for t in relax2] == [("relax2", first[0])]
+    assert np.allclose(relax2[0].problem.velocity_limits, np.sqrt(4.2) * limits)
+    assert dict(relax2[0].profile.options)["ipopt.mu_init"] == 1e-6
+    second = _numbered_optima(problem, [0.3], a, [relax[0].seed])
+    refine = plan.send(list(zip(relax2, second, strict=True)))
+    assert [t.stage for t in refine] == ["refine", "refine", "refine2", "refine2", "refine3"]
+    assert [t.start.solution for t in refine] == [screened[2], screened[0]] * 2 + [second[0]]
+    assert np.array_equal(refine[-1].problem.velocity_limits, limits)
+    assert dict(refine[-1].profile.options)["ipopt.mu_init"] == 1e-6
+    answers = _numbered_optima(problem, [0.6, 0.8, 0.7, 0.9, 0.5], a, [t.seed for t in refine])
+    with pytest.raises(StopIteration) as done:
+        plan.send(list(zip(refine, answers, strict=True)))
+    assert {t.stage for t, _ in done.value.value[0].final} == {"refine", "refine2", "refine3"}
+    assert "relaxed to fit its lifted start" in search.describe()
+    assert "relaxed" not in replace(search, refine_relaxed=False).describe()
+
+
+def test_step_ratio_is_the_lifted_starts_largest_step_over_what_the_velocity_limits_allow(monkeypatch):
+    """`step_ratio` against a lifted start that moves one joint at k times its velocity limit between two
+    waypoints and slower elsewhere: k; `relaxed_problem` scales every limit and so every step allowed, and leaves
+    the problem it relaxes as it was."""
+    problem = problem_from_config(parse_config({}))
+    t, v = problem.toolpath.t, problem.velocity_limits
+    Q = np.zeros((len(t), problem.chain.n_moving))
+    Q[:, 1] = 0.5 * v[1] * t
+    Q[7:, 2] = 3.0 * v[2] * (t[7] - t[6])  # one step of 3 v_max h
+    monkeypatch.setattr(coarse_to_fine, "lifted_guess", lambda p, sol: InitialGuess(q_d=sol, Q=Q))
+    assert coarse_to_fine.step_ratio(problem, problem.chain.design_values) == pytest.approx(3.0)
+    relaxed = coarse_to_fine.relaxed_problem(problem, 2.5)
+    assert np.allclose(relaxed.max_steps, 2.5 * problem.max_steps)
+    assert np.array_equal(problem.velocity_limits, v)
+    assert relaxed.chain is problem.chain
+
 
 @pytest.fixture(scope="module")
 def yaw_placed(milling_12):
