@@ -1148,16 +1148,16 @@ def test_refine_from_coarse_refines_each_refined_candidate_again_from_its_coarse
     assert "from its coarse optimum" not in replace(search, refine_from_coarse=False).describe()
 
 def test_refine_relaxed_refines_a_candidate_whose_lift_steps_too_far_through_relaxed_velocity_limits(monkeypatch):
-    """`Search.refine_relaxed`: each refined candidate whose lifted start steps beyond the velocity limits (r > 1,
-    `step_ratio`) is solved warm with the limits x 1.05 r (stage ``relax``), from that solution with x sqrt(1.05 r)
-    and barrier 1e-6 (``relax2``), then at the problem's own limits from 1e-6 in the stage after the refine's
-    passes; a candidate whose lift fits the limits gets no such pass; the relaxed solves are not in the answers.
-    Driven through the plan, the step ratios given."""
+    """`Search.refine_relaxed`: each of that many best refined candidates whose lifted start steps beyond the
+    velocity limits (r > 1, `step_ratio`) is solved warm with the limits x 1.05 r (stage ``relax``), from that
+    solution with x sqrt(1.05 r) and barrier 1e-6 (``relax2``), then at the problem's own limits from 1e-6 in the
+    stage after the refine's passes; a candidate whose lift fits the limits gets no such pass; the relaxed solves
+    are not in the answers. Driven through the plan, the step ratios given."""
     problem = problem_from_config(parse_config({}))
     a = (0, 0, 1, 0, 1)
     job = Job("", problem)
     search = Search(starts=6, rebranch=0, screen=3, screen_waypoints=20, refine=2, refine_mu_init=(None, 1e-6),
-                    refine_relaxed=True)
+                    refine_relaxed=2)
     plan = coarse_to_fine.plan([job], search)
     explore = next(plan)
     sols = _numbered_optima(problem, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0], a, [t.seed for t in explore])
@@ -1188,7 +1188,14 @@ def test_refine_relaxed_refines_a_candidate_whose_lift_steps_too_far_through_rel
         plan.send(list(zip(refine, answers, strict=True)))
     assert {t.stage for t, _ in done.value.value[0].final} == {"refine", "refine2", "refine3"}
     assert "relaxed to fit its lifted start" in search.describe()
-    assert "relaxed" not in replace(search, refine_relaxed=False).describe()
+    assert "relaxed" not in replace(search, refine_relaxed=0).describe()
+    assert "the best 1 once through velocity limits relaxed" in replace(search, refine_relaxed=1).describe()
+
+    plan = coarse_to_fine.plan([job], replace(search, refine_relaxed=1))  # the best candidate's lift fits: none
+    screen = plan.send(list(zip(next(plan), sols, strict=True)))
+    ratios = {id(screened[2]): 0.9, id(screened[0]): 4.0}
+    assert [t.stage for t in plan.send(list(zip(screen, screened, strict=True)))] == ["refine", "refine", "refine2",
+                                                                                     "refine2"]
 
 
 def test_step_ratio_is_the_lifted_starts_largest_step_over_what_the_velocity_limits_allow(monkeypatch):

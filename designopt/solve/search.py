@@ -92,11 +92,11 @@ class Search:
     one. ``refine_from_coarse``: each refined candidate refined once more, from its coarse optimum lifted straight
     to the full path and solved warm from the warm start's barrier (the stage after the barriers' passes, e.g.
     ``refine3``): a screened solution fits the screen's waypoints and may leave the path between them by more than
-    the velocity limits allow, so its lift can start outside its basin. ``refine_relaxed``: each refined candidate
-    whose lifted start steps further than the velocity limits allow (by r, the largest step over v_max h) refined
-    once more through relaxed limits: solved warm with every velocity limit times 1.05 r (stage ``relax``), then
-    times sqrt(1.05 r) from barrier 1e-6 (``relax2``), then at the limits from 1e-6 (the stage after the other
-    refines); the relaxed solves are not answers. ``screen_mu_init``: the same as
+    the velocity limits allow, so its lift can start outside its basin. ``refine_relaxed``: each of that many best
+    refined candidates (0: none) whose lifted start steps further than the velocity limits allow (by r, the largest
+    step over v_max h) refined once more through relaxed limits: solved warm with every velocity limit times 1.05 r
+    (stage ``relax``), then times sqrt(1.05 r) from barrier 1e-6 (``relax2``), then at the limits from 1e-6 (the
+    stage after the other refines); the relaxed solves are not answers. ``screen_mu_init``: the same as
     ``refine_mu_init`` for the screen (stages ``screen``, ``screen2``, ...), each candidate ranked for the refine by
     its better pass. ``hop``: after the
     strategy and the neighbour step, that many restarts around each of the ``hop_incumbents`` best distinct
@@ -158,7 +158,7 @@ class Search:
     small_arm_perturbation: float | None = None
     refine_mu_init: tuple[float | None, ...] = (None,)
     refine_from_coarse: bool = False
-    refine_relaxed: bool = False
+    refine_relaxed: int = 0
     reflect: int = 0
     reflect_within: float | None = None
     hop: int = 0
@@ -381,7 +381,8 @@ class Search:
         if self.refine_from_coarse and self.screen:
             barrier += ", and once from its coarse optimum"
         if self.refine_relaxed:
-            barrier += ", and once through velocity limits relaxed to fit its lifted start"
+            which = "each" if self.refine_relaxed >= self.refine else f"the best {self.refine_relaxed}"
+            barrier += f", and {which} once through velocity limits relaxed to fit its lifted start"
         if self.small_problem_starts > 1:
             drawn += (f" (a problem smaller than the largest up to {self.small_problem_starts:g}x as many, "
                       f"about its cost)")

@@ -31,7 +31,8 @@ design optimal for the full path. Stages, each across every problem:
    ``small_arm_screens_once``), each candidate ranked by its better pass.
 4. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
    trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
-   once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), and with ``refine_from_coarse``
+   once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), and with ``refine_relaxed`` the
+   best that many once more through velocity limits relaxed to fit their lift, and with ``refine_from_coarse``
    once more from each one's coarse optimum lifted straight to the full path (the next stage: its screened
    solution fits the screen's waypoints and may lift badly), the best of all kept.
 """
@@ -274,11 +275,12 @@ def plan(jobs, search):
         for k in screened:
             refines += lifted(jobs[k], coarse_optima(explored[k], chosen[k]), stage, None, search)
     if search.refine_relaxed:  # and through velocity limits relaxed to fit its lifted start
-        ratios = [[step_ratio(job.problem, sol) for sol in sols] for job, sols in zip(jobs, chosen, strict=True)]
+        ratios = [[step_ratio(job.problem, sol) for sol in sols[:search.refine_relaxed]]
+                  for job, sols in zip(jobs, chosen, strict=True)]
         relaxed = [(k, sol, r) for k, (sols, rs) in enumerate(zip(chosen, ratios, strict=True))
-                   for sol, r in zip(sols, rs, strict=True) if r > 1.0]
+                   for sol, r in zip(sols, rs, strict=False) if r > 1.0]  # rs: the best sols'
         done = []
-        for i, exponent in enumerate((1.0, 0.5)):
+        for i, exponent in enumerate((1.0, 0.5) if relaxed else ()):
             tasks = [lifted(replace(jobs[k], problem=relaxed_problem(jobs[k].problem, (1.05 * r) ** exponent)),
                             [sol], numbered_stage("relax", i), None, search, mu_init=None if i == 0 else 1e-6)[0]
                      for (k, _, r), sol in zip(relaxed, done or [sol for _, sol, _ in relaxed], strict=True)]
