@@ -17,10 +17,13 @@ OPTIMA_SHOWN = 15  # distinct optima drawn in the search-progress figure, best f
 
 
 def full_path(summary: pd.DataFrame) -> pd.DataFrame:
-    """The rows of full-path solves (not the coarse stages of a search: `designopt.tables.is_coarse`)."""
-    from designopt.tables import is_coarse
+    """The rows of full-path solves of the task (not the coarse stages of a search, `designopt.tables.is_coarse`,
+    nor its solves with relaxed velocity limits, `is_relaxed`)."""
+    from designopt.tables import is_coarse, is_relaxed
 
-    return summary[~summary["stage"].map(is_coarse)] if "stage" in summary else summary
+    if "stage" not in summary:
+        return summary
+    return summary[~summary["stage"].map(lambda stage: is_coarse(stage) or is_relaxed(stage))]
 
 
 def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Path) -> list[Path]:

@@ -41,6 +41,8 @@ def best_per_dof(table: pd.DataFrame) -> pd.DataFrame:
 
 # solves on a coarser sampling of the path; every other stage is full-path
 COARSE_STAGES = ("explore", "prescreen", "screen", "hop")
+# full-path solves with the velocity limits relaxed (`Search.refine_relaxed`): steps of a refine, never answers
+RELAXED_STAGES = ("relax",)
 
 
 def stage_kind(stage) -> str:
@@ -54,9 +56,15 @@ def is_coarse(stage) -> bool:
     return stage_kind(stage) in COARSE_STAGES
 
 
+def is_relaxed(stage) -> bool:
+    """Whether a stage solves the task with its velocity limits relaxed (`RELAXED_STAGES`, numbered or not)."""
+    return stage_kind(stage) in RELAXED_STAGES
+
+
 def _stage_of(stage) -> str:
-    """explore, screen, or final (any full-path stage: refine, a multistart start, a neighbour start)."""
-    return stage_kind(stage) if is_coarse(stage) else "final"
+    """explore, screen, relax, or final (any full-path stage of the task itself: refine, a multistart start, a
+    neighbour start)."""
+    return stage_kind(stage) if is_coarse(stage) or is_relaxed(stage) else "final"
 
 
 def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
