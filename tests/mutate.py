@@ -150,7 +150,9 @@ MUTATIONS = [
              ("tests/test_search.py",)),
     Mutation("the refine from the coarse optima named as the first barrier's pass",
              "designopt/solve/strategies/coarse_to_fine.py",
-             'stage = numbered_stage("refine", len(search.refine_mu_init))', 'stage = "refine"',
+             '# each refined candidate refined again from its coarse optimum\n'
+             '        stage = numbered_stage("refine", passes)',
+             '# each refined candidate refined again from its coarse optimum\n        stage = "refine"',
              ("tests/test_search.py",)),
     Mutation("every refined candidate relaxed, whether or not its lift fits the limits",
              "designopt/solve/strategies/coarse_to_fine.py", "for sol, r in zip(sols, rs, strict=False) if r > 1.0]",
