@@ -1,7 +1,8 @@
 """Where a search loses the best design's family: never reached, not screened, or lost after the screen.
 
-A coarse optimum is of the *best family* when every link length of its arm (|a| and |d| of each link, not the
-placement) is within ``--within`` metres of the best design known's (``--reference``): the family the screen and
+A coarse optimum is of the *best family* when every link length of its arm (|a| of each link, and the offsets d
+summed along each run of parallel joint axes, where they are interchangeable: `lengths`; not the placement) is
+within ``--within`` metres of the best design known's (``--reference``): the family the screen and
 the refine can carry to the best design, even where its coarse cost on 10 waypoints is 1.5-2x the best's. For
 each RUN (a directory `search_seeds.py --out DIR` keeps, DIR/<name>/s<seed>) this reads every tracking coarse
 optimum's design (its solution file) and prints:
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -66,8 +68,32 @@ def start_kind(search, number: int) -> str:
     return "other"
 
 
-def lengths(design_joints: dict, names: list[str]) -> np.ndarray:
-    return np.abs([design_joints[name] for name in names])
+PARALLEL = 0.2  # consecutive joint axes are parallel where |sin(alpha)| is below this
+
+
+def lengths(design_joints: dict, names: list[str], grouped_by: dict | None = None) -> np.ndarray:
+    """An arm's link lengths as the kinematics sees them [m]: |a| of each link, and for each run of consecutive
+    parallel joint axes (twist near 0 or pi) the |signed sum| of the offsets d along it, since an offset moves
+    along a parallel axis to the next without changing the arm (d_i + d_(i+1) at twist 0, d_i - d_(i+1) at pi).
+    ``names``: the design's length joints (`linkK.a`, `linkK.d`); a length joint of another name is taken as
+    it is. ``grouped_by``: the design whose twists decide which axes are parallel (None: this one), so that two
+    designs' lengths compare entry by entry; the signs are this design's own."""
+    grouped_by = design_joints if grouped_by is None else grouped_by
+    links = sorted({int(m.group(1)) for n in names if (m := re.fullmatch(r"link(\d+)\.[ad]", n))})
+    out = [abs(design_joints[n]) for n in names if not re.fullmatch(r"link\d+\.[ad]", n)]
+    out += [abs(design_joints[f"link{k}.a"]) for k in links if f"link{k}.a" in names]
+    offsets = [k for k in links if f"link{k}.d" in names]
+    run, sign = 0.0, 1.0
+    for i, k in enumerate(offsets):
+        run += sign * design_joints[f"link{k}.d"]
+        joined = (i + 1 < len(offsets) and offsets[i + 1] == k + 1
+                  and abs(np.sin(grouped_by.get(f"link{k}.alpha", np.pi / 2))) < PARALLEL)
+        if joined:
+            sign *= np.sign(np.cos(design_joints.get(f"link{k}.alpha", 0.0))) or 1.0
+        else:
+            out.append(abs(run))
+            run, sign = 0.0, 1.0
+    return np.array(out)
 
 
 def run_rows(run: Path, reference: dict, within: float) -> tuple[pd.DataFrame, dict]:
@@ -83,7 +109,8 @@ def run_rows(run: Path, reference: dict, within: float) -> tuple[pd.DataFrame, d
     tracks = summary["tracks"].astype(bool)
     explored = summary[kind == "explore"]
     ok = tracks[kind == "explore"]
-    family = [bool(o) and np.abs(lengths(json.loads((run / f).read_text())["design_joints"], names) - best).max()
+    family = [bool(o) and np.abs(lengths(json.loads((run / f).read_text())["design_joints"], names,
+                                                    reference["design_joints"]) - best).max()
               <= within for f, o in zip(explored["solution_file"], ok, strict=True)]
     rows = pd.DataFrame({"run": run.name, "kind": [start_kind(search, int(s)) for s in explored["seed"]],
                          "family": family, "seed": explored["seed"].to_numpy(),
