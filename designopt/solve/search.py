@@ -67,7 +67,8 @@ class Search:
     whose starts have none among them (`leader_of`), and with
     ``prescreen`` > 0 the ``prescreen_keep`` best of the ``prescreen`` next distinct coarse optima solved warm on
     ``prescreen_waypoints`` as the screen's first pass solves (stage ``prescreen``; skipped when the screen's
-    waypoints are no more: `strategies.coarse_to_fine.best_prescreened`), and the
+    waypoints are no more: `strategies.coarse_to_fine.best_prescreened`; with ``screen_from_prescreen`` each
+    screened from its prescreened optimum instead of its coarse optimum: 10, 20, then 40 waypoints), and the
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
     design joint are one optimum; with ``same_arm_cost``, so are two whose arms (every design joint but the
     placement's) lie within ``distinct`` and whose design costs within that fraction of the cheaper's: the same arm
@@ -144,6 +145,7 @@ class Search:
     prescreen: int = 0
     prescreen_keep: int = 8
     prescreen_waypoints: int = 20
+    screen_from_prescreen: bool = False
     refine: int = 4
     distinct: float = 0.02
     same_arm_cost: float | None = None
@@ -346,7 +348,8 @@ class Search:
             capped += " (a smaller problem's more, on more waypoints, in proportion)"
         if self.prescreen:
             capped += (f" and the best {self.prescreen_keep} of the next {self.prescreen} re-ranked on "
-                       f"{self.prescreen_waypoints} waypoints (as the screen's first pass),")
+                       f"{self.prescreen_waypoints} waypoints (as the screen's first pass"
+                       f"{', screened from there' if self.screen_from_prescreen else ''}),")
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
                   f"{self._kkt(self.screen_linear_solver)}{self._repeated()}, if the path has more)"

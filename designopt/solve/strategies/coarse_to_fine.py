@@ -21,7 +21,9 @@ design optimal for the full path. Stages, each across every problem:
    distinct coarse optima after those the screen takes, lifted to ``prescreen_waypoints`` and solved warm as the
    screen's first pass solves (a smaller problem's more, as for the screen); the ``prescreen_keep`` best of them
    join the screen's candidates (`best_prescreened`): coarse optima the exploration's few waypoints rank low but
-   more waypoints rank high, for a fraction of the screen's cost per candidate.
+   more waypoints rank high, for a fraction of the screen's cost per candidate. With ``screen_from_prescreen``
+   the screen lifts their prescreened optima, not their coarse optima (the way 10 -> 20 -> 40 waypoints keeps
+   a basin that a lift straight from 10 waypoints can leave).
 3. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem of several more,
    on more waypoints: `screening`), and the prescreen's, lifted to ``screen_waypoints`` waypoints, solved warm within
@@ -150,11 +152,14 @@ def picked(done, count: int, search, per_form: int | None = None, new_leaders: i
                          same_arm_cost=search.same_arm_cost, lineages=lineages, new_lineages=new_leaders)
 
 
-def best_prescreened(explored, prescreened, keep: int) -> list:
+def best_prescreened(explored, prescreened, keep: int, own: bool = False) -> list:
     """The explored (task, solution) pairs of the ``keep`` prescreened candidates (``prescreened``: (task, solution)
-    of each, its task's start the coarse optimum) whose prescreened optima track at the lowest design cost."""
-    by_seed = {task.seed: (task, sol) for task, sol in explored}
+    of each, its task's start the coarse optimum) whose prescreened optima track at the lowest design cost; with
+    ``own``, their prescreened pairs themselves (the screen then lifts the prescreened optima)."""
     tracking = sorted((d for d in prescreened if d[1].metrics.tracks), key=lambda d: d[1].metrics.design_cost)
+    if own:
+        return tracking[:keep]
+    by_seed = {task.seed: (task, sol) for task, sol in explored}
     return [by_seed[task.seed] for task, _ in tracking[:keep]]
 
 
@@ -256,7 +261,8 @@ def plan(jobs, search):
                           if t.seed not in taken][:more]
             for k, done in zip(pre, by_job([jobs[k] for k in pre], (yield tasks)), strict=True):
                 extra[k] = best_prescreened(explored[k], done,
-                                            round(search.prescreen_keep * screens[k][0] / search.screen))
+                                            round(search.prescreen_keep * screens[k][0] / search.screen),
+                                            search.screen_from_prescreen)
         tasks = [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
                  if i < len(search.passes_for(jobs[k].problem.chain.n_moving))
                  for found, count, how in ((explored[k], screens[k][0], choose), (extra[k], len(extra[k]), {}))
