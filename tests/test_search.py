@@ -1067,7 +1067,8 @@ def test_the_prescreen_adds_the_best_of_the_next_coarse_optima_on_more_waypoints
     """`Search.prescreen`: the ``prescreen`` best distinct coarse optima after the screen's are lifted to
     ``prescreen_waypoints`` (stage ``prescreen``, solved as the screen's first pass: its cap and barrier), and the
     ``prescreen_keep`` of them whose prescreened optima track cheapest join the screen's candidates, each lifted
-    from its coarse optimum (`best_prescreened`), or from its prescreened optimum with ``screen_from_prescreen``;
+    from its coarse optimum (`best_prescreened`), from its prescreened optimum with ``screen_prescreened``
+    "prescreened", both ways with "both" (the prescreened optima in passes of their own, screen3 and screen4);
     without it, or when the screen's waypoints are no more than the
     prescreen's, the screen lifts the best coarse optima alone. Driven through the plan."""
     problem = problem_from_config(parse_config({}))
@@ -1104,19 +1105,31 @@ def test_the_prescreen_adds_the_best_of_the_next_coarse_optima_on_more_waypoints
     pairs = [(SimpleNamespace(seed=t.seed), sol) for t, sol in zip(pre, lifted, strict=True)]
     coarse = [(SimpleNamespace(seed=t.seed), sol) for t, sol in zip(pre, sols[2:6], strict=True)]
     assert [c[1] for c in coarse_to_fine.best_prescreened(coarse, pairs, 5)] == [sols[4], sols[5], sols[2]]
-    # with `screen_from_prescreen` the screen lifts the prescreened optima themselves (10, 20, then 40 waypoints)
+    # "prescreened": the screen lifts the prescreened optima themselves (10, 20, then 40 waypoints)
     assert [c[1] for c in coarse_to_fine.best_prescreened(coarse, pairs, 5, own=True)] == [lifted[2], lifted[3],
                                                                                            lifted[0]]
-    laddered = replace(search, screen_from_prescreen=True)
-    plan, sols, pre = explored(laddered)
-    again = optima([4.0, 0.5, 1.0, 3.0], [t.seed for t in pre])
-    again[1].metrics.tracks = False
-    screen = plan.send(list(zip(pre, again, strict=True)))
-    for stage in ("screen", "screen2"):
-        assert [t.start.solution for t in screen if t.stage == stage] == [sols[0], sols[1], again[2], again[3]]
-    assert {t.problem.toolpath.n for t in screen} == {20}
-    assert "re-ranked on 15 waypoints (as the screen's first pass, screened from there)" in laddered.describe()
+    for how, passes in (("prescreened", {"screen": "own", "screen2": "own"}),
+                        ("both", {"screen": "coarse", "screen2": "coarse", "screen3": "own", "screen4": "own"})):
+        laddered = replace(search, screen_prescreened=how)
+        plan, sols, pre = explored(laddered)
+        again = optima([4.0, 0.5, 1.0, 3.0], [t.seed for t in pre])
+        again[1].metrics.tracks = False
+        screen = plan.send(list(zip(pre, again, strict=True)))
+        assert {t.stage for t in screen} == set(passes)
+        for stage, starts in passes.items():
+            expected = {"coarse": [sols[0], sols[1], sols[4], sols[5]], "own": [sols[0], sols[1], again[2], again[3]]}
+            if how == "both" and starts == "own":
+                expected["own"] = [again[2], again[3]]  # the passes of their own hold the prescreened optima alone
+            assert [t.start.solution for t in screen if t.stage == stage] == expected[starts], (how, stage)
+        assert {t.problem.toolpath.n for t in screen} == {20}
+        # both ways of a candidate share its start number, so `better_pass` keeps its best pass of the four
+        assert len({t.seed for t in screen}) == 4
+    prescreened = replace(search, screen_prescreened="prescreened")
+    assert "(as the screen's first pass, screened from there)" in prescreened.describe()
+    assert "screened from there and from 10" in replace(search, screen_prescreened="both").describe()
     assert "screened from there" not in search.describe()
+    with pytest.raises(ValueError, match="screen_prescreened must be one of coarse, prescreened, both"):
+        replace(search, screen_prescreened="twice")
 
     for without in (replace(search, prescreen=0), replace(search, prescreen_waypoints=20)):
         _, sols, screen = explored(without)

@@ -67,8 +67,9 @@ class Search:
     whose starts have none among them (`leader_of`), and with
     ``prescreen`` > 0 the ``prescreen_keep`` best of the ``prescreen`` next distinct coarse optima solved warm on
     ``prescreen_waypoints`` as the screen's first pass solves (stage ``prescreen``; skipped when the screen's
-    waypoints are no more: `strategies.coarse_to_fine.best_prescreened`; with ``screen_from_prescreen`` each
-    screened from its prescreened optimum instead of its coarse optimum: 10, 20, then 40 waypoints), and the
+    waypoints are no more: `strategies.coarse_to_fine.best_prescreened`), each screened from its coarse optimum
+    (``screen_prescreened`` "coarse"), from its prescreened optimum ("prescreened": 10, 20, then 40 waypoints), or
+    both ways ("both": the prescreened optima in screen passes of their own, the candidate's best pass kept), and the
     ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
     design joint are one optimum; with ``same_arm_cost``, so are two whose arms (every design joint but the
     placement's) lie within ``distinct`` and whose design costs within that fraction of the cheaper's: the same arm
@@ -145,7 +146,7 @@ class Search:
     prescreen: int = 0
     prescreen_keep: int = 8
     prescreen_waypoints: int = 20
-    screen_from_prescreen: bool = False
+    screen_prescreened: str = "coarse"
     refine: int = 4
     distinct: float = 0.02
     same_arm_cost: float | None = None
@@ -171,6 +172,9 @@ class Search:
     draws: int = 1
 
     def __post_init__(self):
+        if self.screen_prescreened not in SCREEN_PRESCREENED:
+            raise ValueError(f"screen_prescreened must be one of {', '.join(SCREEN_PRESCREENED)}, "
+                             f"got {self.screen_prescreened!r}")
         if self.draws < 1:
             raise ValueError(f"draws must be at least 1, got {self.draws}")
 
@@ -349,7 +353,7 @@ class Search:
         if self.prescreen:
             capped += (f" and the best {self.prescreen_keep} of the next {self.prescreen} re-ranked on "
                        f"{self.prescreen_waypoints} waypoints (as the screen's first pass"
-                       f"{', screened from there' if self.screen_from_prescreen else ''}),")
+                       f"{SCREENED_FROM[self.screen_prescreened]}),")
         screen = (f", the best {self.screen} distinct{capped} re-ranked on {self.screen_waypoints} waypoints "
                   f"(<= {self.screen_max_iter} iterations{_barriers(self.screen_mu_init)}"
                   f"{self._kkt(self.screen_linear_solver)}{self._repeated()}, if the path has more)"
@@ -426,6 +430,10 @@ def _barriers(mu_init: tuple[float | None, ...]) -> str:
 # main job (six revolute joints, default search) they made the answer worse (docs/decisions.md, 2026-11-24).
 REGULARISED_CONSTRAINTS = (("ipopt.perturb_always_cd", "yes"),)
 DEGENERATE_JACOBIAN = (*REGULARISED_CONSTRAINTS, ("ipopt.alpha_for_y", "min-dual-infeas"))
+
+# how the prescreened candidates are screened (`Search.screen_prescreened`), as `describe` says it
+SCREENED_FROM = {"coarse": "", "prescreened": ", screened from there", "both": ", screened from there and from 10"}
+SCREEN_PRESCREENED = tuple(SCREENED_FROM)
 
 # the paper's comparisons: every method gets the same seeded cold starts on the full path, start for start
 PAPER = Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1500, time_limit=120.0))

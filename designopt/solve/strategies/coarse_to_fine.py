@@ -21,9 +21,11 @@ design optimal for the full path. Stages, each across every problem:
    distinct coarse optima after those the screen takes, lifted to ``prescreen_waypoints`` and solved warm as the
    screen's first pass solves (a smaller problem's more, as for the screen); the ``prescreen_keep`` best of them
    join the screen's candidates (`best_prescreened`): coarse optima the exploration's few waypoints rank low but
-   more waypoints rank high, for a fraction of the screen's cost per candidate. With ``screen_from_prescreen``
-   the screen lifts their prescreened optima, not their coarse optima (the way 10 -> 20 -> 40 waypoints keeps
-   a basin that a lift straight from 10 waypoints can leave).
+   more waypoints rank high, for a fraction of the screen's cost per candidate. With ``screen_prescreened``
+   "prescreened" the screen lifts their prescreened optima, not their coarse optima (the way 10 -> 20 -> 40
+   waypoints keeps a basin that a lift straight from 10 waypoints can leave, and leaves one that it keeps); with
+   "both" it lifts both, the prescreened optima in passes of their own (stages after the screen's passes, e.g.
+   ``screen3``, ``screen4``), and `better_pass` keeps each candidate's best.
 3. ``screen`` (when the path has more than ``screen_waypoints`` waypoints): the ``screen`` best distinct coarse
    optima (at most ``screen_per_form`` of one form before other forms, when set; a smaller problem of several more,
    on more waypoints: `screening`), and the prescreen's, lifted to ``screen_waypoints`` waypoints, solved warm within
@@ -246,6 +248,7 @@ def plan(jobs, search):
         screens = screening([job.problem for job in jobs], search)
         choose = {"per_form": search.screen_per_form, "new_leaders": search.screen_new_leaders}
         extra = {k: [] for k in screened}  # prescreened coarse optima that join the screen's candidates
+        own = {k: [] for k in screened}  # their prescreened optima, screened in passes of their own ("both")
         pre = [k for k in screened if search.prescreen
                and search.prescreen_waypoints < (screens[k][1] or jobs[k].problem.toolpath.n)]
         if pre:  # the next coarse optima re-ranked on more waypoints, as the screen's first pass solves
@@ -260,15 +263,22 @@ def plan(jobs, search):
                                                   linear_solver=first_solver)
                           if t.seed not in taken][:more]
             for k, done in zip(pre, by_job([jobs[k] for k in pre], (yield tasks)), strict=True):
-                extra[k] = best_prescreened(explored[k], done,
-                                            round(search.prescreen_keep * screens[k][0] / search.screen),
-                                            search.screen_from_prescreen)
+                keep = round(search.prescreen_keep * screens[k][0] / search.screen)
+                extra[k] = best_prescreened(explored[k], done, keep, search.screen_prescreened == "prescreened")
+                if search.screen_prescreened == "both":
+                    own[k] = best_prescreened(explored[k], done, keep, own=True)
         tasks = [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
                  if i < len(search.passes_for(jobs[k].problem.chain.n_moving))
                  for found, count, how in ((explored[k], screens[k][0], choose), (extra[k], len(extra[k]), {}))
                  for task in lifted_tasks([jobs[k]], [found], count, numbered_stage("screen", i), screens[k][1],
                                           search, search.screen_max_iter, mu_init=screen_mu, linear_solver=solver,
                                           **how)]
+        own_pass = len(search.screen_passes)  # the prescreened optima's passes are numbered after the screen's
+        tasks += [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
+                  if own[k] and i < len(search.passes_for(jobs[k].problem.chain.n_moving))
+                  for task in lifted_tasks([jobs[k]], [own[k]], len(own[k]), numbered_stage("screen", own_pass + i),
+                                           screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
+                                           linear_solver=solver)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
     chosen = [[done[i][1] for i in picked(done, search.refine, search)] for done in candidates]
