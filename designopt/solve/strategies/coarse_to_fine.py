@@ -267,18 +267,14 @@ def plan(jobs, search):
                 extra[k] = best_prescreened(explored[k], done, keep, search.screen_prescreened == "prescreened")
                 if search.screen_prescreened == "both":
                     own[k] = best_prescreened(explored[k], done, keep, own=True)
+        own_pass = len(search.screen_passes)  # the prescreened optima's passes are numbered after the screen's
         tasks = [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
                  if i < len(search.passes_for(jobs[k].problem.chain.n_moving))
-                 for found, count, how in ((explored[k], screens[k][0], choose), (extra[k], len(extra[k]), {}))
-                 for task in lifted_tasks([jobs[k]], [found], count, numbered_stage("screen", i), screens[k][1],
-                                          search, search.screen_max_iter, mu_init=screen_mu, linear_solver=solver,
-                                          **how)]
-        own_pass = len(search.screen_passes)  # the prescreened optima's passes are numbered after the screen's
-        tasks += [task for i, (screen_mu, solver) in enumerate(search.screen_passes) for k in screened
-                  if own[k] and i < len(search.passes_for(jobs[k].problem.chain.n_moving))
-                  for task in lifted_tasks([jobs[k]], [own[k]], len(own[k]), numbered_stage("screen", own_pass + i),
-                                           screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
-                                           linear_solver=solver)]
+                 for found, count, how, first in ((explored[k], screens[k][0], choose, 0),
+                                                  (extra[k], len(extra[k]), {}, 0), (own[k], len(own[k]), {}, own_pass))
+                 for task in lifted_tasks([jobs[k]], [found], count, numbered_stage("screen", first + i),
+                                          screens[k][1], search, search.screen_max_iter, mu_init=screen_mu,
+                                          linear_solver=solver, **how)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
     chosen = [[done[i][1] for i in picked(done, search.refine, search)] for done in candidates]
