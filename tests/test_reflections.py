@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -22,6 +23,7 @@ from designopt.kinematics.chain import geometric_jacobian, tool_pose
 from designopt.kinematics.reflections import Reflection, at_bound, reflections, wrap
 from designopt.problem import problem_from_config
 from designopt.solve.local import solve_guess
+from designopt.solve.optima import arm_invariants, distinct_best
 from designopt.solve.profile import SolverProfile
 from designopt.solve.search import PRESETS, Job, Search
 from designopt.solve.strategies import reflect, run_search
@@ -71,6 +73,86 @@ def test_a_reflected_arm_is_the_same_arm(seed):
         np.testing.assert_allclose(wrap(r.joints(CHAIN, q_m2[None, :])[0] - q_m), 0.0, atol=1e-12)
         V = rng.standard_normal((3, CHAIN.n_moving))
         np.testing.assert_allclose(np.abs(r.velocities(CHAIN, V)), np.abs(V))
+
+
+def _twists_turned(q_d, q_m, first: int, last: int):
+    """The same arm written another way: link ``first``'s twist and link ``last``'s turned by pi, every offset d
+    and joint angle theta of the links between (``first`` + 1 .. ``last``) negated: Rx(pi) commutes with Tx and
+    turns Rz(theta) Tz(d) into Rz(-theta) Tz(-d), and two half turns about x cancel."""
+    names = [j.name for j in CHAIN.design]
+    q_d, q_m = np.array(q_d, float), np.array(q_m, float)
+    for link in (first, last):
+        k = names.index(f"link{link}.alpha")
+        q_d[k] = wrap(q_d[k] + np.pi)
+    for link in range(first + 1, last + 1):
+        q_d[names.index(f"link{link}.d")] *= -1
+        q_m[link - 1] *= -1
+    return q_d, q_m
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_one_arm_written_several_ways_has_one_row_of_invariants(seed):
+    """`optima.arm_invariants`: every reflection of a design, and its twists turned by pi on two links with the
+    offsets between them negated (the tool pose the same: forward kinematics), give the design's row; the
+    placement is not in it, and changing a length or the angle between two joint axes changes it."""
+    rng = np.random.default_rng(seed)
+    q_d = np.array([rng.uniform(max(j.lower, -1.0), min(j.upper, 1.0)) for j in CHAIN.design])
+    q_m = rng.uniform(-np.pi, np.pi, CHAIN.n_moving)
+    row = arm_invariants(CHAIN, q_d)
+    names = [j.name for j in CHAIN.design]
+    assert row.shape == (1, len(names) - 6)
+    for r in reflections(CHAIN):
+        np.testing.assert_allclose(arm_invariants(CHAIN, r.design(CHAIN, q_d)), row, atol=1e-12, err_msg=r.name)
+    first, last = sorted(rng.choice(np.arange(1, 7), 2, replace=False))
+    q_d2, q_m2 = _twists_turned(q_d, q_m, first, last)
+    T, T2 = tool_pose(CHAIN, q_m, q_d), tool_pose(CHAIN, q_m2, q_d2)
+    np.testing.assert_allclose(T2, T, atol=1e-12)
+    np.testing.assert_allclose(arm_invariants(CHAIN, q_d2), row, atol=1e-12)
+    placed = q_d.copy()
+    placed[names.index("placement.x")] += 0.5
+    np.testing.assert_allclose(arm_invariants(CHAIN, placed), row)
+    longer = q_d.copy()
+    longer[names.index("link3.a")] += 0.05  # a >= 0
+    turned = q_d.copy()
+    between = np.mod(q_d[names.index("link2.alpha")], np.pi)
+    between = min(between, np.pi - between)  # the angle between link 2's and link 3's axis lines
+    turned[names.index("link2.alpha")] = between + (0.3 if between <= np.pi / 4 else -0.3)
+    for other in (longer, turned):
+        assert np.max(np.abs(arm_invariants(CHAIN, other) - row)) > 0.02
+
+
+# the main job's 1.031x family as the search finds it (seed 1887's answer, rounded): offsets of about 1 mm, where the
+# arm's own symmetry puts them
+RUNNER_UP_DH = [(0.0007, 0.1733, -0.0003), (0.0007, 0.1972, 0.0), (0.0007, 0.0246, -1.5710), (0.0012, 0.1947, 3.1415),
+                (0.0004, 0.2038, 3.13), (0.0012, 0.0009, -1.56)]
+
+
+def test_the_same_arm_written_another_way_at_the_same_cost_is_one_optimum_when_axes_may_point_either_way():
+    """`optima.distinct_best` with ``any_axis_direction``: the main job's 1.031x arm and the same arm with its first
+    and fifth twists turned by pi (the offsets between written at +1 mm, as the bound d >= 0 keeps them: the same
+    arm within 2.4 mm), 0.1 % dearer, are one optimum, so the next distinct arm takes the second place; joint by
+    joint they are two, and a cost 1 % off keeps them two either way."""
+    full = problem_from_config(parse_config({}))
+    names = [j.name for j in full.chain.design]
+    q_d = full.chain.design_values.copy()
+    for i, (d, a, alpha) in enumerate(RUNNER_UP_DH, start=1):
+        q_d[[names.index(f"link{i}.{p}") for p in ("d", "a", "alpha")]] = d, a, alpha
+    turned, _ = _twists_turned(q_d, np.zeros(6), 1, 5)
+    turned[[names.index(f"link{i}.d") for i in range(2, 6)]] *= -1  # back within d >= 0
+    other = q_d.copy()
+    other[names.index("link3.a")] += 0.05
+
+    def stand_in(q, cost):
+        return SimpleNamespace(problem=full, metrics=SimpleNamespace(tracks=True, design_cost=cost),
+                               raw=SimpleNamespace(q_d=q))
+
+    sols = [stand_in(q_d, 1.0), stand_in(turned, 1.001), stand_in(other, 1.004)]
+    assert distinct_best(sols, 2, same_arm_cost=0.002) == [0, 1]
+    assert distinct_best(sols, 2, same_arm_cost=0.002, any_axis_direction=True) == [0, 2]
+    assert distinct_best(sols, 2, any_axis_direction=True) == [0, 1]  # without same_arm_cost: joint by joint
+    dearer = [sols[0], stand_in(turned, 1.01), sols[2]]
+    assert distinct_best(dearer, 3, same_arm_cost=0.002, any_axis_direction=True) == [0, 2, 1]
 
 
 def test_a_reflection_that_would_turn_a_joint_out_of_its_bounds_does_not_apply():

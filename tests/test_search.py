@@ -1226,6 +1226,37 @@ def test_refine_relaxed_refines_a_candidate_whose_lift_steps_too_far_through_rel
                                                                                      "refine2"]
 
 
+def test_refine_distinct_arms_refines_the_next_arm_in_place_of_the_same_arm_written_another_way():
+    """`Search.refine_distinct_arms`: of the screened candidates, one whose arm is a cheaper one's with two twists
+    turned by pi (`optima.arm_invariants`) at a screen cost within ``same_arm_cost`` is that one, so the refine
+    takes the next distinct arm instead; without it (or without ``same_arm_cost``) the refine takes both
+    writings. Driven through the plan."""
+    problem = problem_from_config(parse_config({}))
+    names = [j.name for j in problem.chain.design]
+    a = (0, 0, 1, 0, 1)
+
+    def refined(search):
+        plan = coarse_to_fine.plan([Job("", problem)], search)
+        explore = next(plan)
+        screen = plan.send(list(zip(explore, _numbered_optima(problem, [1.0, 2.0, 3.0, 4.0], a,
+                                                              [t.seed for t in explore]), strict=True)))
+        screened = _numbered_optima(problem, [0.5, 0.5005, 0.9], a, [t.seed for t in screen])
+        turned = screened[0].raw.q_d.copy()
+        for name in ("link1.alpha", "link2.alpha"):
+            turned[names.index(name)] += np.pi
+        turned[names.index("link2.d")] *= -1
+        screened[1].raw.q_d = turned
+        refine = plan.send(list(zip(screen, screened, strict=True)))
+        return [screened.index(t.start.solution) for t in refine]
+
+    search = Search(starts=4, rebranch=0, screen=3, screen_waypoints=20, refine=2, same_arm_cost=0.002)
+    assert refined(search) == [0, 1]
+    assert refined(replace(search, refine_distinct_arms=True)) == [0, 2]
+    assert refined(replace(search, refine_distinct_arms=True, same_arm_cost=None)) == [0, 1]
+    assert "(the refine's whichever way its joint axes point)" in replace(search, refine_distinct_arms=True).describe()
+    assert "whichever way" not in search.describe()
+
+
 def test_step_ratio_is_the_lifted_starts_largest_step_over_what_the_velocity_limits_allow(monkeypatch):
     """`step_ratio` against a lifted start that moves one joint at k times its velocity limit between two
     waypoints and slower elsewhere: k; `relaxed_problem` scales every limit and so every step allowed, and leaves

@@ -36,35 +36,61 @@ def design_distance(a: np.ndarray, b: np.ndarray, angle: np.ndarray) -> float:
 
 
 def cluster_designs(designs: np.ndarray, costs: np.ndarray, angle: np.ndarray, tol: float = 0.02,
-                    arm: np.ndarray | None = None, same_arm_cost: float | None = None) -> np.ndarray:
+                    arm: np.ndarray | None = None, same_arm_cost: float | None = None,
+                    arms: np.ndarray | None = None) -> np.ndarray:
     """Label each design with its local optimum: in order of cost, a design joins the first (cheaper) cluster
     whose representative lies within ``tol`` (m or rad) in every design joint (`design_distance`), else starts a
     new one. With ``same_arm_cost`` (a fraction) it also joins a cluster whose representative's arm -- the design
     joints marked in ``arm`` (`arm_joints`) -- lies within ``tol`` and whose cost it exceeds by at most that
     fraction: the same arm at the same cost, placed elsewhere (without design joints in the arm, a fixed robot's
-    placements, a tie in cost alone is no such evidence: not merged). Each design is compared with every representative
-    at once, its joint differences taken once for both rules: a default run's 880 coarse optima, most of them
-    distinct, are clustered several times between its stages, while the workers wait."""
+    placements, a tie in cost alone is no such evidence: not merged). ``arms`` (one row per design, e.g.
+    `arm_invariants`): compare these rows instead of the arm joints for that rule (within ``tol`` in every
+    column). Each design is compared with every representative at once, its joint differences taken once for both
+    rules: a default run's 880 coarse optima, most of them distinct, are clustered several times between its
+    stages, while the workers wait."""
     designs = np.asarray(designs, float).reshape(len(costs), -1)
     costs = np.asarray(costs, float)
     order = np.argsort(costs, kind="stable")
     labels, leaders, n = np.empty(len(costs), dtype=int), np.empty_like(designs), 0
     leader_costs = np.empty(len(costs))
     merge = same_arm_cost is not None and arm is not None and arm.any()
+    if merge and arms is not None:
+        arms = np.asarray(arms, float).reshape(len(costs), -1)
+        leader_arms = np.empty_like(arms)
     for i in order:
         if n:
             differences = joint_differences(designs[i], leaders[:n], angle)
             close = np.max(differences, axis=-1, initial=0.0) <= tol
             if merge:
-                arm_close = np.max(differences[:, arm], axis=-1) <= tol
+                arm_close = (np.max(differences[:, arm], axis=-1) if arms is None
+                             else np.max(np.abs(leader_arms[:n] - arms[i]), axis=-1, initial=0.0)) <= tol
                 close |= arm_close & (costs[i] <= (1 + same_arm_cost) * leader_costs[:n])
             near = np.flatnonzero(close)
             if near.size:
                 labels[i] = near[0]
                 continue
         labels[i], leaders[n], leader_costs[n] = n, designs[i], costs[i]
+        if merge and arms is not None:
+            leader_arms[n] = arms[i]
         n += 1
     return labels
+
+
+def arm_invariants(chain, designs: np.ndarray) -> np.ndarray:
+    """Each design's arm whichever way its joint axes point (one row per design, `arm_joints`' columns): its
+    lengths by their size (m), its angles as the angle between two lines, folded into [0, pi/2] (rad). A DH
+    arm's reflections (`kinematics.reflections`: a length's sign flipped, the twists beside it turned by pi or
+    negated), a twist turned by pi on two links with the offsets between them negated, and a mirror image
+    all give one row; so the same arm written several ways, at the same cost, is one optimum
+    (`cluster_designs`' ``arms``). Joint by joint: lengths along their axes, other angles (a URDF origin's)
+    folded alike."""
+    arm = arm_joints(chain)
+    designs = np.asarray(designs, float).reshape(-1, len(arm))[:, arm]
+    angle = np.array([j.kind == "angle" for j in chain.design], dtype=bool)[arm]
+    out = np.abs(designs)
+    turn = np.mod(designs[:, angle], np.pi)
+    out[:, angle] = np.minimum(turn, np.pi - turn)
+    return out
 
 
 def form_joints(chain) -> np.ndarray:
@@ -106,7 +132,7 @@ def design_forms(designs: np.ndarray, form: np.ndarray) -> list[tuple[int, ...]]
 
 def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int | None = None,
                   new_forms: int = 0, same_arm_cost: float | None = None, lineages: list | None = None,
-                  new_lineages: int = 0) -> list[int]:
+                  new_lineages: int = 0, any_axis_direction: bool = False) -> list[int]:
     """Indices into ``solutions`` of the best tracking solution of each of the ``count`` cheapest distinct
     optima (`cluster_designs`), cheapest first. ``per_form``: at most this many optima of one form
     (`design_forms`) before the optima of other forms, cheapest first; then, if fewer than ``count`` are taken,
@@ -115,7 +141,9 @@ def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int 
     this many forms not among them, cheapest first. ``same_arm_cost``: the same arm within that fraction of a
     cheaper optimum's cost is that optimum (`cluster_designs`; None: designs compared joint by joint only).
     ``new_lineages``: then the cheapest optimum of each of up to this many lineages not among them, cheapest first,
-    where ``lineages`` gives each solution's (e.g. the second-round leader whose starts found it; None: of none)."""
+    where ``lineages`` gives each solution's (e.g. the second-round leader whose starts found it; None: of none).
+    ``any_axis_direction``: the same arm at the same cost recognised whichever way its joint axes point
+    (`arm_invariants`), not joint by joint."""
     tracking = [i for i, s in enumerate(solutions) if s.metrics.tracks]
     if not tracking or count <= 0:
         return []
@@ -123,7 +151,8 @@ def distinct_best(solutions: list, count: int, tol: float = 0.02, per_form: int 
     angle = np.array([j.kind == "angle" for j in chain.design], dtype=bool)
     costs = np.array([solutions[i].metrics.design_cost for i in tracking])
     designs = np.array([solutions[i].raw.q_d for i in tracking]).reshape(len(tracking), -1)
-    labels = cluster_designs(designs, costs, angle, tol, arm_joints(chain), same_arm_cost)
+    labels = cluster_designs(designs, costs, angle, tol, arm_joints(chain), same_arm_cost,
+                             arm_invariants(chain, designs) if any_axis_direction else None)
     leaders = {}
     for k in np.argsort(costs, kind="stable"):
         leaders.setdefault(labels[k], k)

@@ -98,7 +98,11 @@ class Search:
     refined candidates (0: none) whose lifted start steps further than the velocity limits allow (by r, the largest
     step over v_max h) refined once more through relaxed limits: solved warm with every velocity limit times 1.05 r
     (stage ``relax``), then times sqrt(1.05 r) from barrier 1e-6 (``relax2``), then at the limits from 1e-6 (the
-    stage after the other refines); the relaxed solves are not answers. ``screen_mu_init``: the same as
+    stage after the other refines); the relaxed solves are not answers. ``refine_distinct_arms``: the refine's
+    ``refine`` candidates distinct arms whichever way their joint axes point: with ``same_arm_cost``, a candidate
+    whose arm is a cheaper one's written otherwise (`optima.arm_invariants`: lengths by size, twists as angles
+    between lines; a DH arm's reflections, its twists turned by pi about zero offsets) at a screen cost within that
+    fraction is that candidate, and the next distinct arm takes its place. ``screen_mu_init``: the same as
     ``refine_mu_init`` for the screen (stages ``screen``, ``screen2``, ...), each candidate ranked for the refine by
     its better pass. ``hop``: after the
     strategy and the neighbour step, that many restarts around each of the ``hop_incumbents`` best distinct
@@ -162,6 +166,7 @@ class Search:
     refine_mu_init: tuple[float | None, ...] = (None,)
     refine_from_coarse: bool = False
     refine_relaxed: int = 0
+    refine_distinct_arms: bool = False
     reflect: int = 0
     reflect_within: float | None = None
     hop: int = 0
@@ -395,6 +400,8 @@ class Search:
                       f"about its cost)")
         same = (f"; the same arm within {self.same_arm_cost:.1%} of a cheaper one's cost one optimum"
                 if self.same_arm_cost is not None else "")
+        if self.same_arm_cost is not None and self.refine_distinct_arms:
+            same += " (the refine's whichever way its joint axes point)"
         return (f"coarse to fine: {self.starts} starts{drawn} on {self.explore_waypoints} waypoints (<= "
                 f"{self.explore_max_iter} iterations{kkt}){again}{screen}, the best {self.refine} distinct optima "
                 f"refined on the full path ({cap}{barrier}){reflect}{same}{held}{solver}")

@@ -146,12 +146,15 @@ def coarse_optima(explored, refined) -> list:
     return [sol for task, sol in explored if task.seed in numbers]
 
 
-def picked(done, count: int, search, per_form: int | None = None, new_leaders: int = 0) -> list[int]:
+def picked(done, count: int, search, per_form: int | None = None, new_leaders: int = 0,
+           any_axis_direction: bool = False) -> list[int]:
     """Indices into ``done`` ((task, solution) pairs) of the solutions `lifted_tasks` lifts: `optima.distinct_best`
-    with the search's ``distinct`` and ``same_arm_cost``, each solution's lineage its second-round leader."""
+    with the search's ``distinct`` and ``same_arm_cost``, each solution's lineage its second-round leader; the same
+    arm recognised whichever way its joint axes point with ``any_axis_direction``."""
     lineages = [search.leader_of(task.seed) for task, _ in done] if new_leaders else None
     return distinct_best([sol for _, sol in done], count, search.distinct, per_form,
-                         same_arm_cost=search.same_arm_cost, lineages=lineages, new_lineages=new_leaders)
+                         same_arm_cost=search.same_arm_cost, lineages=lineages, new_lineages=new_leaders,
+                         any_axis_direction=any_axis_direction)
 
 
 def best_prescreened(explored, prescreened, keep: int, own: bool = False) -> list:
@@ -277,7 +280,8 @@ def plan(jobs, search):
                                           linear_solver=solver, **how)]
         found = dict(zip(screened, [better_pass(d) for d in by_job(sub, (yield tasks))], strict=True))
         candidates = [found.get(k, explored[k]) for k in range(len(jobs))]
-    chosen = [[done[i][1] for i in picked(done, search.refine, search)] for done in candidates]
+    chosen = [[done[i][1] for i in picked(done, search.refine, search, any_axis_direction=search.refine_distinct_arms)]
+              for done in candidates]
     refines = [task for i, refine_mu in enumerate(search.refine_mu_init) for job, sols in zip(jobs, chosen, strict=True)
                for task in lifted(job, sols, numbered_stage("refine", i), None, search, mu_init=refine_mu)]
     passes = len(search.refine_mu_init)
