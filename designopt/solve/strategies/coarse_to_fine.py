@@ -33,8 +33,10 @@ design optimal for the full path. Stages, each across every problem:
    of one that lifts well. Once per barrier of ``screen_mu_init`` and linear solver of ``screen_linear_solver``
    (stages ``screen``, ``screen2``, ...: `Search.screen_passes`; a small arm the first pass only, when
    ``small_arm_screens_once``), each candidate ranked by its better pass.
-4. ``refine``: the ``refine`` best distinct screened (or coarse) optima lifted to the full path (design as is,
-   trajectory sampled from the coarser solution's) and solved warm, so that each stays in the basin it was given;
+4. ``refine``: the ``refine`` best distinct screened (or coarse) optima (with ``refine_distinct_arms``, the same
+   arm written another way, e.g. two twists turned by pi about offsets of 0, one candidate) lifted to the full
+   path (design as is, trajectory sampled from the coarser solution's) and solved warm, so that each stays in the
+   basin it was given;
    once per barrier of ``refine_mu_init`` (stages ``refine``, ``refine2``, ...), and with ``refine_relaxed`` the
    best that many once more through velocity limits relaxed to fit their lift, and with ``refine_from_coarse``
    once more from each one's coarse optimum lifted straight to the full path (the next stage: its screened
