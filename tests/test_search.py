@@ -74,7 +74,7 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
                                         screen_mu_init=(None, 1e-6), refine_mu_init=(None, 1e-6),
                                         rebranch_new_forms=4, reflect=3, reflect_within=1.05, rebranch_extra=30,
                                         rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10, prescreen=48,
-                                        refine_relaxed=1, screen_prescreened="both")
+                                        refine_relaxed=1, screen_prescreened="both", refine_distinct_arms=True)
     for name in PRESETS:
         assert search_from_config(parse_config({"search": {"preset": name}})) == PRESETS[name]
     changed = search_from_config(parse_config({"search": {"preset": "paper", "seed": 7, "starts": 3}}))

@@ -449,15 +449,15 @@ PAPER = Search(strategy="multistart", starts=8, profile=SolverProfile(max_iter=1
 # from the 8 best distinct coarse optima and the best of up to 4 forms not among them (20 drawn starts each, 30 more
 # over the branches those miss, 10 more with the design moved by 0.1); the 24 best distinct coarse optima and the best
 # 8 of the next 48 (prescreened on 20 waypoints) screened on 40 waypoints from two barriers, those 8 from their
-# 20-waypoint optima too; the best 4 refined on the full path from two barriers, the best of them once more through
-# relaxed velocity limits where its lifted start steps beyond them; every refined optimum within 1.05x of the best
-# reflected across its length bounds, then the best (3 rounds at most); the same arm placed elsewhere at a cost within
-# 0.2 % one optimum. Each setting was judged on evaluation seeds never tuned on, against the preset before it (seeds
-# better / worse, solve time): docs/benchmarks.md "Search", docs/decisions.md.
+# 20-waypoint optima too; the best 4 distinct arms (whichever way their axes point) refined on the full path from two
+# barriers, the best of them once more through relaxed velocity limits where its lifted start steps beyond them; every
+# refined optimum within 1.05x of the best reflected across its length bounds, then the best (3 rounds at most); the
+# same arm placed elsewhere at a cost within 0.2 % one optimum. Each setting was judged on evaluation seeds never tuned
+# on, against the preset before it (seeds better / worse, solve time): docs/benchmarks.md "Search", docs/decisions.md.
 DEFAULT = Search(starts=160, screen=24, init="home", explore_linear_solver="ldl", screen_mu_init=(None, 1e-6),
                  refine_mu_init=(None, 1e-6), rebranch_new_forms=4, reflect=3, reflect_within=1.05, rebranch_extra=30,
                  rebranch_extra_pool=50, same_arm_cost=0.002, rebranch_moved=10, prescreen=48, refine_relaxed=1,
-                 screen_prescreened="both")
+                 screen_prescreened="both", refine_distinct_arms=True)
 
 PRESETS: dict[str, Search] = {
     # A structure sweep's search per structure (`designopt sweep-structures`): a quarter of the default's starts,
