@@ -33,8 +33,10 @@ from designopt.experiments.runs import search_of_run
 from designopt.tables import stage_kind
 
 ROOT = Path(__file__).resolve().parent.parent
-# a stage's rows are dropped with every later one (refine2, ... follow); "rebranch" is the exploration's second round
-ORDER = ("explore", "rebranch", "prescreen", "screen", "refine", "hop", "reflect")
+# a stage's rows are dropped with every later one (refine2, ... follow); "rebranch" is the exploration's second round;
+# "relax" (`Search.refine_relaxed`) goes with the refine: a solve is resumed by its stage and start number alone, so a
+# kept relax row would stand in for a relaxed solve whose screened start the variant changed
+ORDER = ("explore", "rebranch", "prescreen", "screen", "refine", "relax", "hop", "reflect")
 
 
 def later(stage: str, number: int, start: str, search) -> bool:
