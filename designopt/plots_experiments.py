@@ -10,20 +10,11 @@ import pandas as pd
 from designopt import style
 from designopt.plots import draw_poses, plt, save
 from designopt.style import METHOD_COLORS, fit_3d, label_3d
+from designopt.tables import full_path
 
 METHOD_LABELS = {"to": "TO (collocation)", "fk": "FK (Whitman et al.)", "fk_continuous": "FK, bounded steps"}
 CASE_LABELS = {"placement_only": "placement only", "design_only": "design only", "combined": "design + placement"}
 OPTIMA_SHOWN = 15  # distinct optima drawn in the search-progress figure, best first
-
-
-def full_path(summary: pd.DataFrame) -> pd.DataFrame:
-    """The rows of full-path solves of the task (not the coarse stages of a search, `designopt.tables.is_coarse`,
-    nor its solves with relaxed velocity limits, `is_relaxed`)."""
-    from designopt.tables import is_coarse, is_relaxed
-
-    if "stage" not in summary:
-        return summary
-    return summary[~summary["stage"].map(lambda stage: is_coarse(stage) or is_relaxed(stage))]
 
 
 def design_cost_figure(table: pd.DataFrame, summary: pd.DataFrame, directory: Path) -> list[Path]:

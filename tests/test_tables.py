@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from designopt.solve import cluster_designs, design_distance
 from designopt.solve.optima import design_distances
-from designopt.tables import best_so_far, is_coarse, is_relaxed, structure_table
+from designopt.tables import best_so_far, full_path, is_coarse, is_relaxed, structure_table
 
 
 def test_design_distance_wraps_angles():
@@ -86,8 +86,6 @@ def test_numbered_coarse_stages_are_coarse_and_never_a_structures_answer():
 def test_relaxed_solves_are_full_path_but_never_an_answer():
     """A solve with relaxed velocity limits (`Search.refine_relaxed`: relax, relax2) is on the full path but not of
     the task: a structure's best and the figures' full-path rows leave it out, however cheap it is."""
-    from designopt.plots_experiments import full_path
-
     assert [is_relaxed(s) for s in ("relax", "relax2", "refine", "refine3", "screen")] == [True, True, False, False,
                                                                                            False]
     summary = pd.DataFrame({"structure": ["RR"] * 4, "stage": ["relax", "relax2", "refine", "refine3"],

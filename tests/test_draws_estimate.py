@@ -1,0 +1,33 @@
+"""What `benchmarks/draws_estimate.py` counts as a draw's answer, on a run directory written by hand."""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
+from draws_estimate import draw_answers  # noqa: E402
+
+from designopt.solve import preset  # noqa: E402
+from designopt.solve.search import search_to_dict  # noqa: E402
+
+
+def test_a_draws_answer_is_its_cheapest_tracking_full_path_solve_never_a_relaxed_or_coarse_one(tmp_path):
+    """Two draws (start numbers seed * 1000 + index, draw j from seed + j * 1,000,000): the coarse stages and the
+    solves with relaxed velocity limits (`Search.refine_relaxed`: relax, relax2) are cheaper but are not answers;
+    a non-tracking solve is none either, and a draw with no tracking full-path solve answers inf."""
+    search = replace(preset("default"), seed=7, draws=2)
+    (tmp_path / "search.json").write_text(json.dumps(search_to_dict(search)))
+    first, second = 7000, 1_000_007 * 1000
+    rows = [("explore", first + 1, 0.5, True), ("screen", first + 1, 0.8, True), ("relax", first + 1, 0.6, True),
+            ("relax2", first + 1, 0.7, True), ("refine", first + 1, 3.0, True), ("refine2", first + 2, 2.0, True),
+            ("reflect", first + 3, 1.5, False),
+            ("explore", second + 1, 0.4, True), ("relax", second + 1, 0.9, True), ("refine", second + 1, 4.0, False)]
+    pd.DataFrame(rows, columns=["stage", "seed", "design_cost", "tracks"]).to_csv(tmp_path / "summary.csv",
+                                                                                 index=False)
+    assert draw_answers(tmp_path, 2.0) == pytest.approx([1.0, float("inf")])
