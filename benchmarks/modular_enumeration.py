@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from designopt import tables
 from designopt.config import load_config
 from designopt.experiments.adapters import case_config
 from designopt.experiments.modular import catalogue_from_config, fix_modules
@@ -34,7 +35,6 @@ from designopt.problem import problem_from_config
 from designopt.results_io import RunDirectory
 from designopt.solve import Job, SolverProfile, preset, run_search
 from designopt.solve.strategies.coarse_to_fine import coarse_problem
-from designopt.tables import is_coarse
 from designopt.verify import verify_file
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -47,10 +47,10 @@ def label(assignment) -> str:
 
 def best_per_case(summary: pd.DataFrame, prefix: str, full_path: bool = False) -> pd.Series:
     """The best tracking cost of each assignment (cases named prefix + digits); ``full_path``: of full-path solves
-    only (not a search's coarse stages)."""
+    only (not a search's coarse stages, nor its solves with relaxed velocity limits: `tables.full_path`)."""
     rows = summary[summary["case"].astype(str).str.startswith(prefix) & (summary["tracks"].astype(str) == "True")]
     if full_path:
-        rows = rows[~rows["stage"].map(is_coarse)]
+        rows = tables.full_path(rows)
     return rows.groupby("case")["design_cost"].min()
 
 
@@ -133,7 +133,7 @@ def main() -> None:
 
     # the best design as a solution file, when it beats the one kept
     row = summary[(summary["case"] == f"f{best['assignment']}") & (summary["tracks"].astype(str) == "True")
-                  & ~summary["stage"].map(is_coarse)]
+                  ].pipe(tables.full_path)
     path = run.path / row.sort_values("design_cost").iloc[0]["solution_file"]
     reference = Path(args.reference)
     kept = json.loads(reference.read_text())["metrics"]["design_cost"] if reference.exists() else np.inf

@@ -29,7 +29,7 @@ import pandas as pd
 from designopt.config import load_config
 from designopt.experiments.modular import NEIGHBOURHOOD_SAMPLE, catalogue_from_config
 from designopt.modular import same_robot, screened_candidates
-from designopt.tables import is_coarse
+from designopt.tables import full_path
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -39,7 +39,7 @@ def costs(run: Path) -> tuple[dict, dict]:
     summary = pd.read_csv(run / "summary.csv")
     tracks = summary["tracks"].astype(str) == "True"
     out = []
-    for prefix, rows in (("s", summary[tracks]), ("f", summary[tracks & ~summary["stage"].map(is_coarse)])):
+    for prefix, rows in (("s", summary[tracks]), ("f", full_path(summary[tracks]))):
         rows = rows[rows["case"].astype(str).str.startswith(prefix)]
         best = rows.groupby("case")["design_cost"].min()
         out.append({tuple(int(c) - 1 for c in case[1:]): float(v) for case, v in best.items()})

@@ -190,7 +190,7 @@ MUTATIONS = [
     Mutation("a relaxed solve counts as a full-path solve of the task (figures, draws' answers)", "designopt/tables.py",
              "return summary[~summary[\"stage\"].map(lambda stage: is_coarse(stage) or is_relaxed(stage))]",
              "return summary[~summary[\"stage\"].map(is_coarse)]",
-             ("tests/test_tables.py", "tests/test_draws_estimate.py")),
+             ("tests/test_tables.py", "tests/test_benchmark_answers.py")),
     Mutation("the relaxed refine's second step keeps the first step's limits",
              "designopt/solve/strategies/coarse_to_fine.py",
              "for i, exponent in enumerate((1.0, 0.5) if relaxed else ()):",

@@ -1,4 +1,5 @@
-"""What `benchmarks/draws_estimate.py` counts as a draw's answer, on a run directory written by hand."""
+"""What the benchmark tools count as an answer (`benchmarks/draws_estimate.py`, `benchmarks/modular_enumeration.py`),
+on summaries written by hand: never a coarse stage's solve or one with relaxed velocity limits."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 from draws_estimate import draw_answers  # noqa: E402
+from modular_enumeration import best_per_case  # noqa: E402
 
 from designopt.solve import preset  # noqa: E402
 from designopt.solve.search import search_to_dict  # noqa: E402
@@ -31,3 +33,13 @@ def test_a_draws_answer_is_its_cheapest_tracking_full_path_solve_never_a_relaxed
     pd.DataFrame(rows, columns=["stage", "seed", "design_cost", "tracks"]).to_csv(tmp_path / "summary.csv",
                                                                                  index=False)
     assert draw_answers(tmp_path, 2.0) == pytest.approx([1.0, float("inf")])
+
+
+def test_an_assignments_full_path_best_leaves_out_its_coarse_and_relaxed_solves():
+    """The modular refine's search relaxes its best candidate's velocity limits once (the default's
+    `refine_relaxed`); that solve is cheaper than the assignment's answer and is not one."""
+    summary = pd.DataFrame({"case": ["f12", "f12", "f12", "f12", "f34", "s12"],
+                            "stage": ["screen", "relax", "refine", "refine2", "refine", "explore"],
+                            "design_cost": [0.1, 0.2, 3.0, 2.0, 5.0, 0.05], "tracks": [True] * 6})
+    assert best_per_case(summary, "f", full_path=True).to_dict() == {"f12": 2.0, "f34": 5.0}
+    assert best_per_case(summary, "f").to_dict() == {"f12": 0.1, "f34": 5.0}
