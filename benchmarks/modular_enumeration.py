@@ -132,8 +132,8 @@ def main() -> None:
               f"{np.nanmedian(drawn['full_path_cost'] / drawn['screening_cost']):.3f}")
 
     # the best design as a solution file, when it beats the one kept
-    row = summary[(summary["case"] == f"f{best['assignment']}") & (summary["tracks"].astype(str) == "True")
-                  ].pipe(tables.full_path)
+    tracked = summary[(summary["case"] == f"f{best['assignment']}") & (summary["tracks"].astype(str) == "True")]
+    row = tables.full_path(tracked)
     path = run.path / row.sort_values("design_cost").iloc[0]["solution_file"]
     reference = Path(args.reference)
     kept = json.loads(reference.read_text())["metrics"]["design_cost"] if reference.exists() else np.inf

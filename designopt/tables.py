@@ -61,18 +61,18 @@ def is_relaxed(stage) -> bool:
     return stage_kind(stage) in RELAXED_STAGES
 
 
-def full_path(summary: pd.DataFrame) -> pd.DataFrame:
-    """The rows of full-path solves of the task: not the coarse stages of a search (`is_coarse`), nor its solves
-    with relaxed velocity limits (`is_relaxed`); a summary without stages (a plain multistart) as it is."""
-    if "stage" not in summary:
-        return summary
-    return summary[~summary["stage"].map(lambda stage: is_coarse(stage) or is_relaxed(stage))]
-
-
 def _stage_of(stage) -> str:
     """explore, screen, relax, or final (any full-path stage of the task itself: refine, a multistart start, a
     neighbour start)."""
     return stage_kind(stage) if is_coarse(stage) or is_relaxed(stage) else "final"
+
+
+def full_path(summary: pd.DataFrame) -> pd.DataFrame:
+    """The rows of full-path solves of the task (`_stage_of` "final"): not the coarse stages of a search, nor its
+    solves with relaxed velocity limits; a summary without stages (a plain multistart) as it is."""
+    if "stage" not in summary:
+        return summary
+    return summary[summary["stage"].map(_stage_of) == "final"]
 
 
 def structure_table(summary: pd.DataFrame) -> pd.DataFrame:
