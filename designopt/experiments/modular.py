@@ -231,9 +231,10 @@ def module_refine(search: Search) -> Search:
     (coarse to fine; the search's seed) with `REFINE_STARTS` coarse starts, moved until they reach the path (no
     second round on new joint branches, MUMPS in the exploration too, 12 screened once and one refine per candidate:
     none of these measured on modular robots), as the enumeration that found the best modular robot known solved its
-    candidates (`benchmarks/modular_enumeration.py`). Every other setting is the default's as it stands, so the
-    default's later additions (the prescreen, the prescreened candidates screened both ways, distinct arms refined,
-    the relaxed pass for the best) came in unmeasured on modular robots too (`Search.describe` prints them).
+    candidates (`benchmarks/modular_enumeration.py`). Every other setting is the default's as it stands
+    (`Search.describe` prints them); the default's additions of 2026-12-04 (the prescreen, the prescreened candidates
+    screened both ways, distinct arms refined, the relaxed pass for the best) were measured on modular robots after
+    they came in: the same spread over 20 fresh seeds as the search before them (docs/results.md, C7).
     The config's own search (the ``paper`` preset's 4 cold starts in the shipped config) lost 1.3-1.5x on
     assignments it shares with the enumeration; 80 coarse starts missed an assignment's own best on 3 of
     7 evaluation seeds (1.24-1.41x where 160 starts reach 1.05x: docs/decisions.md)."""
