@@ -2,10 +2,11 @@
 
 Reads a finished `modular_enumeration.py` run (every assignment's screening cost on the coarse path, and the
 full-path cost of the best screened and of a random sample) and replays the neighbourhood stage of `designopt
-modular` (`designopt.experiments.modular`: a local search over one-link changes on screening costs from a start
-assignment and seeded random ones, then the best screened re-solved on the full path) for many seeds, with the
-enumeration's costs in place of the solves. Prints, per budget, the distribution over seeds of (the search's
-full-path answer / the best full-path cost of the enumeration) and how many assignments it screened.
+modular` (`designopt.experiments.modular`: a local search over one-link changes and exchanges of neighbouring
+links on screening costs from a start assignment and seeded random ones, then the best screened re-solved on the
+full path) for many seeds, with the enumeration's costs in place of the solves. Prints, per budget, the
+distribution over seeds of (the search's full-path answer / the best full-path cost of the enumeration) and how
+many assignments it screened.
 
 The replay uses the enumeration's screening (search seed 0) for every seed: what it measures is the local
 search and its starts, not the screening's own seed-to-seed noise (real runs: docs/results.md). Like the search,

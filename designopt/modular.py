@@ -100,6 +100,14 @@ def neighbours(assignment: tuple[int, ...], n_modules: int) -> list[tuple[int, .
             if k != assignment[i]]
 
 
+def swapped(assignment: tuple[int, ...]) -> list[tuple[int, ...]]:
+    """Every assignment with the modules of two neighbouring links exchanged, where they differ: the same
+    modules in another order, which one-link changes reach only through two steps (the first of which may cost
+    more)."""
+    return [assignment[:i] + (assignment[i + 1], assignment[i]) + assignment[i + 2:]
+            for i in range(len(assignment) - 1) if assignment[i] != assignment[i + 1]]
+
+
 def lift_choices(assignment: tuple[int, ...], catalogue: Catalogue) -> list[list[tuple[int, float]]]:
     """For every link, the modules that build the same robot in its place, each with the lift it adds (m).
 
@@ -205,11 +213,11 @@ def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate
     ``incumbent`` (None for a start). ``same(assignment)`` (default: the assignment itself) is a key shared by
     assignments that build one robot (`same_robot`): one of them is evaluated, the first met, and the others
     take its cost for nothing; ``budget`` counts robots evaluated. A step evaluates every neighbour of the
-    incumbent (one link's module changed) and moves to the cheapest if it beats the incumbent; a start ends at a
-    local optimum of this neighbourhood or when the budget is spent. ``cheapest_first``: every start is
-    evaluated first, in one batch, and the local searches run from the cheapest start on (a start inside a basin
-    searched already costs nothing more). Returns (best assignment, its cost, every (assignment evaluated, cost)
-    in order: one per robot).
+    incumbent (one link's module changed) and every exchange of two neighbouring links' modules (`swapped`),
+    and moves to the cheapest if it beats the incumbent; a start ends at a local optimum of this neighbourhood
+    or when the budget is spent. ``cheapest_first``: every start is evaluated first, in one batch, and the local
+    searches run from the cheapest start on (a start inside a basin searched already costs nothing more). Returns
+    (best assignment, its cost, every (assignment evaluated, cost) in order: one per robot).
     """
     same = same or (lambda a: a)
     seen: dict = {}  # robot -> (the assignment evaluated for it, its cost)
@@ -235,7 +243,7 @@ def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate
         current = start
         (cost,) = costs([current])
         while len(seen) < budget:
-            around = neighbours(current, n_modules)
+            around = neighbours(current, n_modules) + swapped(current)
             values = costs(around, current)
             k = int(np.argmin(values))
             if values[k] >= cost:

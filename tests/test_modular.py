@@ -41,6 +41,7 @@ from designopt.modular import (
     same_robot,
     screened_candidates,
     spread_assignments,
+    swapped,
     within_box,
 )
 from designopt.problem import problem_from_config
@@ -292,8 +293,9 @@ def test_neighbourhood_search_finds_the_optimum_of_a_separable_cost():
 
     def evaluate(batch, incumbent):
         calls.extend(batch)
-        # a step's batch is its incumbent's neighbours (one link changed), which warm-start from it
-        assert incumbent is None or all(sum(x != y for x, y in zip(a, incumbent, strict=True)) == 1 for a in batch)
+        # a step's batch is its incumbent's neighbours (one link changed) and exchanges of two neighbouring
+        # links' modules, which warm-start from it
+        assert incumbent is None or all(a in neighbours(incumbent, 3) or a in swapped(incumbent) for a in batch)
         return [cost(a) for a in batch]
 
     truth = min(itertools.product(range(3), repeat=4), key=cost)
@@ -302,6 +304,36 @@ def test_neighbourhood_search_finds_the_optimum_of_a_separable_cost():
         best, value, seen = neighbourhood_search([start], 3, evaluate, budget=81)
         assert tuple(best) == truth and value == pytest.approx(cost(truth))
         assert len(calls) == len(set(calls)) == len(seen)  # each assignment solved once
+
+
+@given(st.lists(st.integers(0, 4), min_size=1, max_size=7).map(tuple))
+def test_swapped_exchanges_two_neighbouring_links_that_differ(assignment):
+    """Each swapped assignment holds the same modules, differs in exactly two neighbouring links, and has their
+    modules exchanged; there is one per pair of unequal neighbouring links, none twice."""
+    out = swapped(assignment)
+    assert len(out) == len(set(out)) == sum(x != y for x, y in itertools.pairwise(assignment))
+    for a in out:
+        assert sorted(a) == sorted(assignment)
+        changed = [i for i, (x, y) in enumerate(zip(a, assignment, strict=True)) if x != y]
+        i = changed[0]
+        assert changed == [i, i + 1] and (a[i], a[i + 1]) == (assignment[i + 1], assignment[i])
+
+
+def test_a_swap_escapes_where_one_link_changes_cannot():
+    """Closed-form truth: a cost that charges any change of the set of modules more than it can ever gain, and
+    otherwise counts the pairs of links out of order. Every one-link change of a start costs more, so a search by
+    one-link changes stays there; exchanges of neighbouring links sort the assignment (bubble sort) to the
+    optimum, the modules in ascending order."""
+    start = (3, 1, 2, 0, 2)
+
+    def cost(a):
+        if sorted(a) != sorted(start):
+            return 100.0
+        return float(sum(a[i] > a[j] for i, j in itertools.combinations(range(len(a)), 2)))
+
+    assert all(cost(a) > cost(start) for a in neighbours(start, 4))
+    best, value, _ = neighbourhood_search([start], 4, lambda b, _: [cost(a) for a in b], budget=500)
+    assert tuple(best) == (0, 1, 2, 2, 3) and value == 0.0
 
 
 def test_neighbourhood_search_keeps_its_budget_and_escapes_a_rounding_trap():

@@ -5,15 +5,15 @@ Stages, each written to summary.csv as a ``case``:
   continuous_modular  TO with weight * L_mod added: links are pulled toward catalogue modules
   rounded             every link replaced by its nearest module, evaluated on the stage-2 trajectory
   modular             modules fixed; placement and trajectory re-solved (the modular design)
-  neighbourhood       beyond the paper: a search over module assignments, coarse to fine like the continuous one --
-                      a local search (one link's module changed at a time) from the cheapest of the rounded
-                      assignment and a seeded sample spread over the catalogue (every module equally often on
-                      every link), each candidate screened on a coarse sampling of the path (cases
-                      sc-<modules>; a neighbour of the incumbent also warm from the incumbent's screening
+  neighbourhood       beyond the paper: a search over module assignments, coarse to fine like the continuous one -- a
+                      local search (a step: one link's module changed, or two neighbouring links' modules exchanged)
+                      from the cheapest of the rounded assignment and a seeded sample spread over the catalogue (every
+                      module equally often on every link), each candidate screened on a coarse sampling of the path
+                      (cases sc-<modules>; a neighbour of the incumbent also warm from the incumbent's screening
                       optimum); the best distinct screened optima searched on the full path with the default search at
-                      `REFINE_STARTS` coarse starts (cases nb-<modules>). One assignment per robot: assignments
-                      that differ by a lift along base z are solved once, with the placement z free over all of
-                      their boxes, and the best reported as the assignment whose placement z lies in the box
+                      `REFINE_STARTS` coarse starts (cases nb-<modules>). One assignment per robot: assignments that
+                      differ by a lift along base z are solved once, with the placement z free over all of their boxes,
+                      and the best reported as the assignment whose placement z lies in the box
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 
 Every stage of the paper's method is a search of one problem with the config's search (the shipped config uses
@@ -298,10 +298,10 @@ class ModuleCosts:
     modules-fixed problem (placement and trajectory free, from the rounded stage's placement; on ``waypoints`` of
     the path, None: all) searched with ``search`` (None: the experiment's, like the ``modular`` stage), all of a
     batch in one search (cases ``<tag><module numbers>``); the neighbours of an ``incumbent`` also get one warm
-    start from the incumbent's best solution (stage ``warm``): a module changed on one link moves the best
-    placement and trajectory little, so a basin one family member found is tried on its neighbours. NaN when no
-    start tracks. ``absorbed``: the placement z is free over the range of every assignment of the same robot
-    (`lifted_modules`). ``best`` keeps each evaluated assignment's best solution."""
+    start from the incumbent's best solution (stage ``warm``): a module changed on one link (or two exchanged)
+    moves the best placement and trajectory little, so a basin one family member found is tried on its
+    neighbours. NaN when no start tracks. ``absorbed``: the placement z is free over the range of every
+    assignment of the same robot (`lifted_modules`). ``best`` keeps each evaluated assignment's best solution."""
 
     def __init__(self, setup, base, catalogue, placement, tag, search: Search | None = None,
                  waypoints: int | None = None, absorbed: bool = False):
