@@ -1,12 +1,12 @@
 """The modular neighbourhood search replayed on the enumeration's screening: how often it ends at the best assignment.
 
-Reads a finished `modular_enumeration.py` run (every assignment's screening cost on the coarse path, and the
-full-path cost of the best screened and of a random sample) and replays the neighbourhood stage of `designopt
-modular` (`designopt.experiments.modular`: a local search over one-link changes and exchanges of neighbouring
-links on screening costs from a start assignment and seeded random ones, then the best screened re-solved on the
-full path) for many seeds, with the enumeration's costs in place of the solves. Prints, per budget, the
-distribution over seeds of (the search's full-path answer / the best full-path cost of the enumeration) and how
-many assignments it screened.
+Reads a finished `modular_enumeration.py` run (every assignment's screening cost on the coarse path, and the full-path
+cost of the best screened and of a random sample) and replays the neighbourhood stage of `designopt modular`
+(`designopt.experiments.modular`: a local search over one-link changes, with `--swaps` also exchanges of neighbouring
+links, on screening costs from a start assignment and seeded random ones, then the best screened re-solved on the full
+path) for many seeds, with the enumeration's costs in place of the solves. Prints, per budget, the distribution over
+seeds of (the search's full-path answer / the best full-path cost of the enumeration) and how many assignments it
+screened.
 
 The replay uses the enumeration's screening (search seed 0) for every seed: what it measures is the local
 search and its starts, not the screening's own seed-to-seed noise (real runs: docs/results.md). Like the search,
@@ -15,7 +15,7 @@ with its placement z in the box, so a robot costs what its first assignment met 
 solves it with the placement z of any assignment of the robot.
 
     .venv/bin/python benchmarks/modular_search_eval.py RUN_DIR [--first-seed 1000] [--seeds 20]
-        [--budget 100 200 300] [--sample-share 0.1667] [--refine 8] [--start 213151]
+        [--budget 100 200 300] [--sample-share 0.1667] [--refine 8] [--start 213151] [--swaps]
 """
 
 from __future__ import annotations
@@ -47,14 +47,15 @@ def costs(run: Path) -> tuple[dict, dict]:
     return out[0], out[1]
 
 
-def replay(screen: dict, full: dict, start, seed: int, budget: int, share: float, refine: int, catalogue):
+def replay(screen: dict, full: dict, start, seed: int, budget: int, share: float, refine: int, catalogue,
+           swaps: bool = False):
     """(the best screening cost it found, the answer's full-path cost, assignments screened, refined candidates
     without a full-path cost). The answer is the best full-path cost among the refined candidates that the
     enumeration solved on the full path: an upper bound when some were not (they ranked below its refinement), NaN
     when none was. An assignment the screening did not track costs inf."""
     screened = lambda batch, _: [screen.get(a, np.inf) for a in batch]  # noqa: E731
     ranked, evaluated = screened_candidates(start, len(catalogue.modules), screened, budget, round(budget * share),
-                                            refine, seed, partial(same_robot, catalogue=catalogue))
+                                            refine, seed, partial(same_robot, catalogue=catalogue), swaps)
     known = [full[a] for a in ranked if a in full]
     found = min(c for _, c in evaluated)
     return found, (min(known) if known else np.nan), len(evaluated), len(ranked) - len(known)
@@ -76,6 +77,7 @@ def main() -> None:
     parser.add_argument("--sample-share", type=float, default=NEIGHBOURHOOD_SAMPLE,
                         help="the share of the budget screened as a spread sample before the local searches")
     parser.add_argument("--refine", type=int, default=8)
+    parser.add_argument("--swaps", action="store_true", help="a step also exchanges two neighbouring links' modules")
     parser.add_argument("--start", default="213151",
                         help="the first start's modules (the rounded assignment; default: seed 0's in docs/results.md)")
     args = parser.parse_args()
@@ -89,7 +91,7 @@ def main() -> None:
           f"path (best {best:.6g}); seeds {args.first_seed}-{args.first_seed + args.seeds - 1}")
     for budget in args.budget:
         found, answer, spent, unknown = zip(*[replay(screen, full, start, seed, budget, args.sample_share, args.refine,
-                                                     catalogue)
+                                                     catalogue, args.swaps)
                                               for seed in range(args.first_seed, args.first_seed + args.seeds)],
                                             strict=True)
         print(f"budget {budget} (screened {int(np.median(spent))} median): best screened found / best screening "

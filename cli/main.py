@@ -369,6 +369,8 @@ def modular(
                                                                 "robot; 0: no neighbourhood search).")] = 300,
     refine: Annotated[int, typer.Option("--refine", min=1, help="Best distinct screening optima the neighbourhood "
                                                                 "search searches on the full path.")] = 8,
+    swaps: Annotated[bool, typer.Option("--swaps/--no-swaps", help="A step of the neighbourhood search also "
+                                        "exchanges two neighbouring links' modules.")] = False,
 ):
     """Modular design: continuous TO with L_mod, round links to modules, re-solve placement, search neighbouring
     assignments (+ FK, plain TO)."""
@@ -377,7 +379,7 @@ def modular(
     cfg = load(config)
     with Bar("modular") as bar:
         result = run_modular(cfg, out_dir, name, bar, resume=resume, jobs=jobs, weight=weight,
-                             neighbourhood_budget=budget, neighbourhood_refine=refine)
+                             neighbourhood_budget=budget, neighbourhood_refine=refine, neighbourhood_swaps=swaps)
     show(_frame_table(result.table, "modular design: best tracking start per stage"))
     out.print(f"results: {result.directory.path}")
 

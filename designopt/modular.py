@@ -206,18 +206,18 @@ def lifts_absorbed(catalogue: Catalogue, box: tuple[float, float]) -> bool:
 
 
 def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate, budget: int,
-                         cheapest_first: bool = False, same=None):
+                         cheapest_first: bool = False, same=None, swaps: bool = False):
     """Best-improvement local search over module assignments, from each of ``starts`` in turn.
 
     ``evaluate(assignments, incumbent) -> costs`` solves a batch (NaN or inf: does not track), the neighbours of
     ``incumbent`` (None for a start). ``same(assignment)`` (default: the assignment itself) is a key shared by
     assignments that build one robot (`same_robot`): one of them is evaluated, the first met, and the others
     take its cost for nothing; ``budget`` counts robots evaluated. A step evaluates every neighbour of the
-    incumbent (one link's module changed) and every exchange of two neighbouring links' modules (`swapped`),
-    and moves to the cheapest if it beats the incumbent; a start ends at a local optimum of this neighbourhood
-    or when the budget is spent. ``cheapest_first``: every start is evaluated first, in one batch, and the local
-    searches run from the cheapest start on (a start inside a basin searched already costs nothing more). Returns
-    (best assignment, its cost, every (assignment evaluated, cost) in order: one per robot).
+    incumbent (one link's module changed; with ``swaps`` also every exchange of two neighbouring links' modules,
+    `swapped`) and moves to the cheapest if it beats the incumbent; a start ends at a local optimum of this
+    neighbourhood or when the budget is spent. ``cheapest_first``: every start is evaluated first, in one batch,
+    and the local searches run from the cheapest start on (a start inside a basin searched already costs nothing
+    more). Returns (best assignment, its cost, every (assignment evaluated, cost) in order: one per robot).
     """
     same = same or (lambda a: a)
     seen: dict = {}  # robot -> (the assignment evaluated for it, its cost)
@@ -243,7 +243,7 @@ def neighbourhood_search(starts: list[tuple[int, ...]], n_modules: int, evaluate
         current = start
         (cost,) = costs([current])
         while len(seen) < budget:
-            around = neighbours(current, n_modules) + swapped(current)
+            around = neighbours(current, n_modules) + (swapped(current) if swaps else [])
             values = costs(around, current)
             k = int(np.argmin(values))
             if values[k] >= cost:
@@ -263,14 +263,15 @@ def spread_assignments(count: int, n_links: int, n_modules: int, seed: int) -> l
 
 
 def screened_candidates(start: tuple[int, ...], n_modules: int, screen, budget: int, sample: int, refine: int,
-                        seed: int, same=None):
+                        seed: int, same=None, swaps: bool = False):
     """The coarse half of the modular search: ``start`` (the rounded assignment) and ``sample`` seeded
     `spread_assignments` screened in one batch (``screen(assignments, incumbent)``), then `neighbourhood_search`
     from them cheapest first, within ``budget`` robots screened in all (``same``: which assignments are one
-    robot, see `neighbourhood_search`). Returns (the ``refine`` best screened assignments that track and are
-    `distinct_optima`, best first; every (assignment, screening cost) in the order screened)."""
+    robot, and ``swaps``: see `neighbourhood_search`). Returns (the ``refine`` best screened assignments that
+    track and are `distinct_optima`, best first; every (assignment, screening cost) in the order screened)."""
     starts = [tuple(start), *spread_assignments(sample, len(start), n_modules, seed)]
-    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget, cheapest_first=True, same=same)
+    _, _, evaluated = neighbourhood_search(starts, n_modules, screen, budget, cheapest_first=True, same=same,
+                                           swaps=swaps)
     return distinct_optima([(a, c) for a, c in evaluated if np.isfinite(c)], refine), evaluated
 
 

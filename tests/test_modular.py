@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
@@ -222,6 +223,30 @@ def test_a_rounded_assignment_that_does_not_track_still_gets_the_neighbourhood_s
     assert all((r["d"], r["a"], r["alpha"]) in modules for r in json.loads(built.read_text())["dh"])
 
 
+@pytest.mark.parametrize(("flag", "swaps"), [([], False), (["--swaps"], True), (["--no-swaps"], False)])
+def test_the_swaps_flag_reaches_the_search(tmp_path, monkeypatch, flag, swaps):
+    """`designopt modular --swaps` hands the neighbourhood search its exchanges of neighbouring links; off unless
+    asked for."""
+    from types import SimpleNamespace
+
+    from typer.testing import CliRunner
+
+    from cli.main import app
+    from designopt.experiments import modular as experiment
+
+    seen = {}
+
+    def fake_run(cfg, out, name, bar, **kwargs):
+        seen.update(kwargs)
+        return SimpleNamespace(table=pd.DataFrame({"stage": ["modular"]}), directory=SimpleNamespace(path=tmp_path))
+
+    monkeypatch.setattr(experiment, "run_modular", fake_run)
+    config = Path(__file__).resolve().parent.parent / "configs" / "modular.yaml"
+    result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path), *flag])
+    assert result.exit_code == 0, result.output
+    assert seen["neighbourhood_swaps"] is swaps
+
+
 def test_mixed_structure_is_a_one_line_error(tmp_path):
     import yaml
     from typer.testing import CliRunner
@@ -301,7 +326,7 @@ def test_neighbourhood_search_finds_the_optimum_of_a_separable_cost():
     truth = min(itertools.product(range(3), repeat=4), key=cost)
     for start in [(0, 0, 0, 0), (2, 1, 0, 2)]:
         calls.clear()
-        best, value, seen = neighbourhood_search([start], 3, evaluate, budget=81)
+        best, value, seen = neighbourhood_search([start], 3, evaluate, budget=81, swaps=True)
         assert tuple(best) == truth and value == pytest.approx(cost(truth))
         assert len(calls) == len(set(calls)) == len(seen)  # each assignment solved once
 
@@ -322,8 +347,8 @@ def test_swapped_exchanges_two_neighbouring_links_that_differ(assignment):
 def test_a_swap_escapes_where_one_link_changes_cannot():
     """Closed-form truth: a cost that charges any change of the set of modules more than it can ever gain, and
     otherwise counts the pairs of links out of order. Every one-link change of a start costs more, so a search by
-    one-link changes stays there; exchanges of neighbouring links sort the assignment (bubble sort) to the
-    optimum, the modules in ascending order."""
+    one-link changes stays there; with ``swaps`` exchanges of neighbouring links sort the assignment (bubble sort)
+    to the optimum, the modules in ascending order."""
     start = (3, 1, 2, 0, 2)
 
     def cost(a):
@@ -332,7 +357,10 @@ def test_a_swap_escapes_where_one_link_changes_cannot():
         return float(sum(a[i] > a[j] for i, j in itertools.combinations(range(len(a)), 2)))
 
     assert all(cost(a) > cost(start) for a in neighbours(start, 4))
-    best, value, _ = neighbourhood_search([start], 4, lambda b, _: [cost(a) for a in b], budget=500)
+    evaluate = lambda batch, _: [cost(a) for a in batch]  # noqa: E731
+    best, value, _ = neighbourhood_search([start], 4, evaluate, budget=500)
+    assert tuple(best) == start and value == cost(start)
+    best, value, _ = neighbourhood_search([start], 4, evaluate, budget=500, swaps=True)
     assert tuple(best) == (0, 1, 2, 2, 3) and value == 0.0
 
 

@@ -6,14 +6,14 @@ Stages, each written to summary.csv as a ``case``:
   rounded             every link replaced by its nearest module, evaluated on the stage-2 trajectory
   modular             modules fixed; placement and trajectory re-solved (the modular design)
   neighbourhood       beyond the paper: a search over module assignments, coarse to fine like the continuous one -- a
-                      local search (a step: one link's module changed, or two neighbouring links' modules exchanged)
-                      from the cheapest of the rounded assignment and a seeded sample spread over the catalogue (every
-                      module equally often on every link), each candidate screened on a coarse sampling of the path
-                      (cases sc-<modules>; a neighbour of the incumbent also warm from the incumbent's screening
-                      optimum); the best distinct screened optima searched on the full path with the default search at
-                      `REFINE_STARTS` coarse starts (cases nb-<modules>). One assignment per robot: assignments that
-                      differ by a lift along base z are solved once, with the placement z free over all of their boxes,
-                      and the best reported as the assignment whose placement z lies in the box
+                      local search (a step: one link's module changed; with `--swaps` also two neighbouring links'
+                      modules exchanged) from the cheapest of the rounded assignment and a seeded sample spread over the
+                      catalogue (every module equally often on every link), each candidate screened on a coarse sampling
+                      of the path (cases sc-<modules>; a neighbour of the incumbent also warm from the incumbent's
+                      screening optimum); the best distinct screened optima searched on the full path with the default
+                      search at `REFINE_STARTS` coarse starts (cases nb-<modules>). One assignment per robot:
+                      assignments that differ by a lift along base z are solved once, with the placement z free over all
+                      of their boxes, and the best reported as the assignment whose placement z lies in the box
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 
 Every stage of the paper's method is a search of one problem with the config's search (the shipped config uses
@@ -64,6 +64,7 @@ NEIGHBOURHOOD_SAMPLE = 1 / 6  # share of the budget: spread assignments screened
 NEIGHBOURHOOD_REFINE = 8  # best distinct screening optima re-solved on the full path
 SCREEN_WAYPOINTS = 10  # the screening's sampling of the path
 REFINE_STARTS = 160  # coarse starts of each best screened assignment's full-path search
+NEIGHBOURHOOD_SWAPS = False  # a step also exchanges two neighbouring links' modules (under evaluation: decisions.md)
 # w_lin (1/m^2) and w_ang of the similarity distance (SPEC §3)
 LINEAR_WEIGHT, ANGULAR_WEIGHT = 1.0, 0.25
 
@@ -158,7 +159,8 @@ def _setup(cfg: Config, out_root: Path, experiment: str, run_name: str | None, r
 def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progress: Progress | None = None,
                 figures: bool = True, resume: bool = False, jobs: int = -1, weight: float = WEIGHT,
                 neighbourhood_budget: int = NEIGHBOURHOOD_BUDGET, search: Search | None = None,
-                neighbourhood_refine: int = NEIGHBOURHOOD_REFINE) -> ModularResult:
+                neighbourhood_refine: int = NEIGHBOURHOOD_REFINE,
+                neighbourhood_swaps: bool = NEIGHBOURHOOD_SWAPS) -> ModularResult:
     s = _setup(cfg, out_root, "modular", run_name, resume, jobs, progress, search)
     catalogue, run, base = s.catalogue, s.run, s.base
     best = {"continuous": _stage(s, base, "continuous")}
@@ -168,7 +170,8 @@ def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progre
     searched = assignment
     if continuous is not None and neighbourhood_budget:  # also when no start of the rounded assignment tracked
         searched, best["neighbourhood"], screened = _module_search(s, base, catalogue, placement, assignment, modular,
-                                                                    neighbourhood_budget, refine=neighbourhood_refine)
+                                                                    neighbourhood_budget, refine=neighbourhood_refine,
+                                                                    swaps=neighbourhood_swaps)
         run.log(f"neighbourhood search: {screened} robots screened, best {[k + 1 for k in searched]}")
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
@@ -242,10 +245,12 @@ def module_refine(search: Search) -> Search:
                   explore_linear_solver=None, screen_mu_init=(None,), refine_mu_init=(None,))
 
 
-def _module_search(setup, base, catalogue, placement, rounded, modular, budget, refine=NEIGHBOURHOOD_REFINE):
+def _module_search(setup, base, catalogue, placement, rounded, modular, budget, refine=NEIGHBOURHOOD_REFINE,
+                   swaps=NEIGHBOURHOOD_SWAPS):
     """The neighbourhood stage: a local search over assignments on screening costs within ``budget`` screened
     robots, from the cheapest of the rounded assignment and a sample spread over the catalogue (a
-    `NEIGHBOURHOOD_SAMPLE` share of the budget) on; then the ``refine`` best distinct screening optima searched on
+    `NEIGHBOURHOOD_SAMPLE` share of the budget) on (``swaps``: a step also exchanges two neighbouring links'
+    modules); then the ``refine`` best distinct screening optima searched on
     the full path (`module_refine`). When the placement z is free and absorbs lifts (`lifts_absorbed`), the
     assignments that build one robot up to a lift along base z are one robot: screened once, solved with the
     placement z any of them could take (`lifted_range`), and reported as the one whose placement lies in the box
@@ -258,7 +263,8 @@ def _module_search(setup, base, catalogue, placement, rounded, modular, budget, 
     screen = ModuleCosts(setup, base, catalogue, placement, "sc-", module_screen(setup.search), SCREEN_WAYPOINTS,
                          absorbed)
     ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget,
-                                            round(budget * NEIGHBOURHOOD_SAMPLE), refine, setup.search.seed, same)
+                                            round(budget * NEIGHBOURHOOD_SAMPLE), refine, setup.search.seed, same,
+                                            swaps)
     full = ModuleCosts(setup, base, catalogue, placement, "nb-", module_refine(setup.search), absorbed=absorbed)
     if modular is not None:
         full.best[tuple(rounded)] = modular  # already solved: the modular stage
