@@ -247,16 +247,15 @@ def module_refine(search: Search) -> Search:
 
 def _module_search(setup, base, catalogue, placement, rounded, modular, budget, refine=NEIGHBOURHOOD_REFINE,
                    swaps=NEIGHBOURHOOD_SWAPS):
-    """The neighbourhood stage: a local search over assignments on screening costs within ``budget`` screened
-    robots, from the cheapest of the rounded assignment and a sample spread over the catalogue (a
-    `NEIGHBOURHOOD_SAMPLE` share of the budget) on (``swaps``: a step also exchanges two neighbouring links'
-    modules); then the ``refine`` best distinct screening optima searched on
-    the full path (`module_refine`). When the placement z is free and absorbs lifts (`lifts_absorbed`), the
-    assignments that build one robot up to a lift along base z are one robot: screened once, solved with the
-    placement z any of them could take (`lifted_range`), and reported as the one whose placement lies in the box
-    (`within_box`). Returns (best assignment, its solution, robots screened); never worse than the rounded
-    assignment's re-solve ``modular`` (None when none of its starts tracked: then the full-path search may solve the
-    rounded assignment again, if it is among the best screened)."""
+    """The neighbourhood stage: a local search over assignments on screening costs within ``budget`` screened robots,
+    from the cheapest of the rounded assignment and a sample spread over the catalogue (a `NEIGHBOURHOOD_SAMPLE` share
+    of the budget) on (``swaps``: a step also exchanges two neighbouring links' modules); then the ``refine`` best
+    distinct screening optima searched on the full path (`module_refine`). When the placement z is free and absorbs
+    lifts (`lifts_absorbed`), the assignments that build one robot up to a lift along base z are one robot: screened
+    once, solved with the placement z any of them could take (`lifted_range`), and reported as the one whose placement
+    lies in the box (`within_box`). Returns (best assignment, its solution, robots screened); never worse than the
+    rounded assignment's re-solve ``modular`` (None when none of its starts tracked: then the full-path search may solve
+    the rounded assignment again, if it is among the best screened)."""
     z = base.chain.joint("placement.z")
     absorbed = z.role is Role.DESIGN and lifts_absorbed(catalogue, (z.lower, z.upper))
     same = partial(same_robot, catalogue=catalogue) if absorbed else None
