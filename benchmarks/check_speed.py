@@ -11,6 +11,7 @@ one process, median of --repeats runs, and prints waypoints, NLP size and second
 from __future__ import annotations
 
 import argparse
+import signal
 import statistics
 import time
 from pathlib import Path
@@ -55,4 +56,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly
     main()

@@ -13,6 +13,7 @@ own numpy and coal code, unchanged) is left out: each problem is timed without i
 from __future__ import annotations
 
 import argparse
+import signal
 import time
 from dataclasses import replace
 
@@ -76,4 +77,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly
     main()

@@ -17,6 +17,7 @@ the config it ran.
 from __future__ import annotations
 
 import argparse
+import signal
 from pathlib import Path
 
 import casadi as ca
@@ -67,4 +68,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly
     main()

@@ -11,6 +11,7 @@ default NLP. (The reference files only ever get better: a search that finds a be
 from __future__ import annotations
 
 import argparse
+import signal
 from pathlib import Path
 
 from designopt.config import load_config
@@ -38,4 +39,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly
     main()

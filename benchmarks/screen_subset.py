@@ -16,6 +16,7 @@ candidates change would answer is `replay_stages.py`'s (a worktree with the vari
 from __future__ import annotations
 
 import argparse
+import signal
 from pathlib import Path
 
 import pandas as pd
@@ -77,4 +78,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly
     main()

@@ -13,6 +13,7 @@ the variant when its problems are the same.
 from __future__ import annotations
 
 import argparse
+import signal
 from pathlib import Path
 
 import pandas as pd
@@ -74,4 +75,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly
     main()

@@ -15,6 +15,7 @@ the lower of a kept reference and the sweep's own best when ``--save`` names the
 from __future__ import annotations
 
 import argparse
+import signal
 import tempfile
 import time
 from dataclasses import replace
@@ -68,4 +69,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly
     main()

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import heapq
+import signal
 from datetime import datetime
 from pathlib import Path
 from types import SimpleNamespace
@@ -126,4 +127,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # piped into head: stop quietly
     main()
