@@ -370,7 +370,7 @@ def modular(
     refine: Annotated[int, typer.Option("--refine", min=1, help="Best distinct screening optima the neighbourhood "
                                                                 "search searches on the full path.")] = 8,
     swaps: Annotated[bool, typer.Option("--swaps/--no-swaps", help="A step of the neighbourhood search also "
-                                        "exchanges two neighbouring links' modules.")] = False,
+                                        "exchanges two neighbouring links' modules.")] = True,
 ):
     """Modular design: continuous TO with L_mod, round links to modules, re-solve placement, search neighbouring
     assignments (+ FK, plain TO)."""

@@ -223,10 +223,10 @@ def test_a_rounded_assignment_that_does_not_track_still_gets_the_neighbourhood_s
     assert all((r["d"], r["a"], r["alpha"]) in modules for r in json.loads(built.read_text())["dh"])
 
 
-@pytest.mark.parametrize(("flag", "swaps"), [([], False), (["--swaps"], True), (["--no-swaps"], False)])
+@pytest.mark.parametrize(("flag", "swaps"), [([], True), (["--swaps"], True), (["--no-swaps"], False)])
 def test_the_swaps_flag_reaches_the_search(tmp_path, monkeypatch, flag, swaps):
-    """`designopt modular --swaps` hands the neighbourhood search its exchanges of neighbouring links; off unless
-    asked for."""
+    """`designopt modular` hands the neighbourhood search its exchanges of neighbouring links unless `--no-swaps`;
+    the CLI's default is the library's."""
     from types import SimpleNamespace
 
     from typer.testing import CliRunner
@@ -245,6 +245,8 @@ def test_the_swaps_flag_reaches_the_search(tmp_path, monkeypatch, flag, swaps):
     result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path), *flag])
     assert result.exit_code == 0, result.output
     assert seen["neighbourhood_swaps"] is swaps
+    if not flag:
+        assert swaps is experiment.NEIGHBOURHOOD_SWAPS
 
 
 def test_mixed_structure_is_a_one_line_error(tmp_path):

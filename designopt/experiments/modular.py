@@ -6,14 +6,14 @@ Stages, each written to summary.csv as a ``case``:
   rounded             every link replaced by its nearest module, evaluated on the stage-2 trajectory
   modular             modules fixed; placement and trajectory re-solved (the modular design)
   neighbourhood       beyond the paper: a search over module assignments, coarse to fine like the continuous one -- a
-                      local search (a step: one link's module changed; with `--swaps` also two neighbouring links'
-                      modules exchanged) from the cheapest of the rounded assignment and a seeded sample spread over the
-                      catalogue (every module equally often on every link), each candidate screened on a coarse sampling
-                      of the path (cases sc-<modules>; a neighbour of the incumbent also warm from the incumbent's
-                      screening optimum); the best distinct screened optima searched on the full path with the default
-                      search at `REFINE_STARTS` coarse starts (cases nb-<modules>). One assignment per robot:
-                      assignments that differ by a lift along base z are solved once, with the placement z free over all
-                      of their boxes, and the best reported as the assignment whose placement z lies in the box
+                      local search (a step: one link's module changed or two neighbouring links' modules exchanged;
+                      `--no-swaps`: changes only) from the cheapest of the rounded assignment and a seeded sample spread
+                      over the catalogue (every module equally often on every link), each candidate screened on a coarse
+                      sampling of the path (cases sc-<modules>; a neighbour of the incumbent also warm from the
+                      incumbent's screening optimum); the best distinct screened optima searched on the full path with
+                      the default search at `REFINE_STARTS` coarse starts (cases nb-<modules>). One assignment per
+                      robot: assignments that differ by a lift along base z are solved once, with the placement z free
+                      over all of their boxes, and the best reported as the assignment whose placement z lies in the box
   fk                  the FK baseline on the continuous problem, for comparison (C7)
 
 Every stage of the paper's method is a search of one problem with the config's search (the shipped config uses
@@ -64,7 +64,7 @@ NEIGHBOURHOOD_SAMPLE = 1 / 6  # share of the budget: spread assignments screened
 NEIGHBOURHOOD_REFINE = 8  # best distinct screening optima re-solved on the full path
 SCREEN_WAYPOINTS = 10  # the screening's sampling of the path
 REFINE_STARTS = 160  # coarse starts of each best screened assignment's full-path search
-NEIGHBOURHOOD_SWAPS = False  # a step also exchanges two neighbouring links' modules (under evaluation: decisions.md)
+NEIGHBOURHOOD_SWAPS = True  # a step also exchanges two neighbouring links' modules (decisions.md, "Modular design")
 # w_lin (1/m^2) and w_ang of the similarity distance (SPEC §3)
 LINEAR_WEIGHT, ANGULAR_WEIGHT = 1.0, 0.25
 
