@@ -17,7 +17,7 @@ import pandas as pd
 from designopt.errors import InputError
 
 SUMMARY_COLUMNS = [
-    "experiment", "case", "stage", "method", "structure", "dof", "n_prismatic", "n_design_joints",
+    "experiment", "case", "stage", "method", "structure", "dof", "n_prismatic", "n_design_joints", "waypoints",
     "design_cost", "max_position_error", "max_axis_error", "max_joint_step", "tracks", "best",
     "status", "success", "iterations", "solve_time_s", "build_time_s", "n_variables", "n_constraints",
     "objective", "regularization", "min_standoff", "kinematic_drift", "held", "seed",

@@ -112,6 +112,9 @@ class Solution:
             "dof": len(structure),
             "n_prismatic": structure.count("P"),
             "n_design_joints": self.problem.chain.n_design,
+            # the path this solve tracked: a search's explore and screen stages solve shorter ones than the
+            # refine, so design costs compare within one count only
+            "waypoints": len(self.problem.toolpath.t),
             **self.metrics.row(),
             "status": r.status,
             "success": r.success,
@@ -254,11 +257,43 @@ def to_dict(sol: Solution) -> dict:
     }
 
 
+def json_text(data) -> str:
+    """JSON text that reads like the data: an object one key per line (nested objects indented by one space), a
+    list of rows or objects one element per line, every other value (a row, a scalar, an object inside a list) on
+    one line. Lists go through json's C encoder, a table of numbers in one call; ``json.dump`` with an indent runs
+    json's Python encoder over every number instead. ``json.loads`` of the text equals ``json.loads`` of
+    ``json.dumps(data)``."""
+    return _json_lines(data, "")
+
+
+def _json_lines(value, indent: str) -> str:
+    kind = type(value)
+    if kind is dict and value and all(type(k) is str for k in value):
+        inner = indent + " "
+        items = (f"{inner}{_json_string(k)}: {_json_lines(v, inner)}" for k, v in value.items())
+        return "{\n" + ",\n".join(items) + "\n" + indent + "}"
+    if kind is float:
+        return repr(value) if math.isfinite(value) else json.dumps(value)
+    if kind is str:
+        return _json_string(value)
+    if kind is list and value and all(type(v) in (list, dict) for v in value):
+        inner = indent + " "
+        if all(type(v) is list and all(type(x) in _NUMBERS for x in v) for v in value):
+            # rows of numbers: one call of the encoder, a line break between rows ("], [" is nowhere else)
+            return "[\n" + inner + json.dumps(value)[1:-1].replace("], [", "],\n" + inner + "[") + "\n" + indent + "]"
+        return "[\n" + ",\n".join(inner + json.dumps(v) for v in value) + "\n" + indent + "]"
+    return json.dumps(value)
+
+
+_NUMBERS = (float, int, bool, type(None))
+_json_string = json.encoder.encode_basestring_ascii  # what json.dumps writes a string as (ensure_ascii)
+
+
 def write_json(data: dict, path: Path) -> None:
-    """Write JSON atomically (temporary file + rename), so a killed run never leaves half a file."""
+    """Write `json_text` atomically (temporary file + rename), so a killed run never leaves half a file."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.NamedTemporaryFile("w", dir=path.parent, suffix=".tmp", delete=False) as fh:
-        json.dump(data, fh, indent=1)
+        fh.write(json_text(data) + "\n")
         tmp = fh.name
     os.replace(tmp, path)
 

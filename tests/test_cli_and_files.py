@@ -11,9 +11,12 @@ import pandas as pd
 import pytest
 import yaml
 from conftest import gantry_config
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from cli.main import app
+from designopt.solution import json_text
 from designopt.verify import verify_file
 
 runner = CliRunner()
@@ -51,6 +54,9 @@ def test_run_writes_the_run_directory(finished_run):
     assert set(required) <= set(summary.columns)
     assert summary["best"].sum() == 1 and summary.loc[summary["best"], "stage"].item() == "refine"
     assert (summary["stiffness_revolute"] == 1.0).all()
+    # the path each solve tracked: the config's 12 waypoints in the refine, the search's 10 in the exploration
+    waypoints = summary.groupby("stage")["waypoints"].unique()
+    assert list(waypoints["refine"]) == [12] and list(waypoints["explore"]) == [10]
 
 
 def test_progress_is_plain_lines_when_not_on_a_terminal(tmp_path, monkeypatch):
@@ -99,12 +105,19 @@ def test_piped_output_is_not_cut(finished_run):
 def test_every_solution_file_reverifies(finished_run):
     _, run = finished_run
     files = sorted((run / "solutions").glob("*.json")) + [run / "best.json"]
-    assert len(files) == len(pd.read_csv(run / "summary.csv")) + 1
+    summary = pd.read_csv(run / "summary.csv")
+    assert len(files) == len(summary) + 1
+    waypoints = dict(zip(summary["solution_file"], summary["waypoints"], strict=True))
     for f in files:
-        data = json.loads(f.read_text())
+        text = f.read_text()
+        data = json.loads(text)
         assert data["schema"] == "designopt.solution/1"
         assert [row["d"] for row in data["dh"]] == [None, None, None]  # P links: d moves
         assert len(data["q"]) == len(data["toolpath"]["t"])
+        if f.name != "best.json":
+            assert len(data["q"]) == waypoints[f"solutions/{f.name}"]
+        # one line per waypoint: the first row of q on its own line, as the text of its numbers
+        assert "\n  " + json.dumps(data["q"][0]) + ",\n" in text
         assert verify_file(f) == [], f
 
 
@@ -216,3 +229,21 @@ def test_a_run_draws_every_standard_figure_of_its_best_solution():
     from designopt.experiments import run
 
     assert run.SOLUTION_FIGURES == tuple(plots.SOLUTION_FIGURES)
+
+
+_scalars = st.none() | st.booleans() | st.integers() | st.floats() | st.text(alphabet="[], {}\":ab\n")
+_json = st.recursive(_scalars, lambda inner: st.lists(inner, max_size=4)
+                     | st.dictionaries(st.text(alphabet="[], {}\":ab", max_size=4), inner, max_size=4), max_leaves=30)
+
+
+@settings(max_examples=300, deadline=None)
+@given(_json)
+def test_solution_text_is_the_same_json_as_the_standard_encoders(data):
+    # json_text lays out rows of numbers by editing the encoder's text: strings holding "], [" and NaN must survive
+    assert json.dumps(json.loads(json_text(data))) == json.dumps(data)
+
+
+def test_solution_text_puts_each_row_of_a_table_on_its_own_line():
+    text = json_text({"q": [[1.0, -2.5], [3.0, None]], "dh": [{"d": None}], "m": {"k": "], ["}})
+    assert text.splitlines() == ['{', ' "q": [', '  [1.0, -2.5],', '  [3.0, null]', ' ],', ' "dh": [',
+                                 '  {"d": null}', ' ],', ' "m": {', '  "k": "], ["', ' }', '}']
