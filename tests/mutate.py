@@ -858,6 +858,12 @@ MUTATIONS = [
              "designopt/solve/strategies/coarse_to_fine.py",
              "warm = search.profile.warmed()", "warm = search.profile.scaled(search.explore_objective_scale).warmed()",
              ("tests/test_search.py",)),
+    Mutation("a solution file's table rows joined without their commas", "designopt/solution.py",
+             '.replace("], [", "],\\n" + inner + "[")', '.replace("], [", "]\\n" + inner + "[")',
+             ("tests/test_cli_and_files.py",)),
+    Mutation("summary.csv counts a solve's waypoints as its intervals", "designopt/solution.py",
+             '"waypoints": len(self.problem.toolpath.t),', '"waypoints": len(self.problem.toolpath.t) - 1,',
+             ("tests/test_cli_and_files.py",)),
 ]
 
 
