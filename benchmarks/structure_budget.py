@@ -10,6 +10,8 @@ large-budget costs), the geometric mean of the ratios and the CPU:
         --variant quick: --variant rebranch4:rebranch=4 --variant starts80:starts=80 --json budget.json
     .venv/bin/python benchmarks/structure_budget.py --table budget.json    # [STRUCTURES]: only those
 
+A variant ``NAME:preset=P,...`` starts from preset P's search (`designopt.solve.search.PRESETS`) instead of the
+config's, keeping the config's solver profile (the sweep's caps and IPOPT options), then sets the other fields.
 ``--save DIR`` also writes each run's best solution, ``DIR/<structure>_<seed>_<variant>.json`` (a solution file:
 ``python -m designopt.verify`` re-checks it). A structure of 4-6 joints takes 4-20 s of CPU per run. Alone, a
 structure gets the preset's ``starts`` and ``screen``; in a sweep a smaller one gets more (`small_problem_starts`),
@@ -33,6 +35,7 @@ from designopt.config import load_config
 from designopt.experiments.adapters import search_from_config
 from designopt.experiments.sweep import sweep_jobs
 from designopt.solution import write_solution
+from designopt.solve.search import preset
 from designopt.solve.strategies import run_search
 from designopt.solve.tasks import fan_out
 
@@ -59,7 +62,11 @@ def run(config: Path, structures: list[str], seeds: list[int], variants: list[st
             for name, fields in map(variant, variants):
                 if (structure, seed, name) in have:
                     continue
-                search = replace(search_from_config(cfg), seed=seed, structure_neighbours=False, **fields)
+                search = search_from_config(cfg)
+                if "preset" in fields:  # another preset's search, under the config's solver profile
+                    fields = dict(fields)
+                    search = replace(preset(str(fields.pop("preset"))), profile=search.profile)
+                search = replace(search, seed=seed, structure_neighbours=False, **fields)
                 cpu = 0.0
 
                 def execute(tasks):
