@@ -371,6 +371,9 @@ def modular(
                                                                 "search searches on the full path.")] = 8,
     swaps: Annotated[bool, typer.Option("--swaps/--no-swaps", help="A step of the neighbourhood search also "
                                         "exchanges two neighbouring links' modules.")] = True,
+    refine_starts: Annotated[int, typer.Option("--refine-starts", min=1, help="Coarse starts of the full-path search "
+                                               "of each refined optimum (fewer: a cheaper, less thorough "
+                                               "search).")] = 160,
 ):
     """Modular design: continuous TO with L_mod, round links to modules, re-solve placement, search neighbouring
     assignments (+ FK, plain TO)."""
@@ -379,7 +382,8 @@ def modular(
     cfg = load(config)
     with Bar("modular") as bar:
         result = run_modular(cfg, out_dir, name, bar, resume=resume, jobs=jobs, weight=weight,
-                             neighbourhood_budget=budget, neighbourhood_refine=refine, neighbourhood_swaps=swaps)
+                             neighbourhood_budget=budget, neighbourhood_refine=refine, neighbourhood_swaps=swaps,
+                             neighbourhood_refine_starts=refine_starts)
     show(_frame_table(result.table, "modular design: best tracking start per stage"))
     out.print(f"results: {result.directory.path}")
 

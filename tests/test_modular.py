@@ -17,7 +17,6 @@ from hypothesis import strategies as st
 from designopt.config import parse_config
 from designopt.design_space import build_chain
 from designopt.experiments.modular import (
-    REFINE_STARTS,
     catalogue_from_config,
     fix_modules,
     module_values,
@@ -136,8 +135,9 @@ def test_modular_command_writes_every_stage(tmp_path):
     config.write_text(yaml.safe_dump({"name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 12},
                                       "placement": {"xyz": [0.45, 0.0, -0.2]},
                                       "search": {"preset": "paper", "starts": 1}}))
+    # 40 coarse starts per refined optimum (the command's default, REFINE_STARTS, quadruples this test's time)
     result = CliRunner().invoke(app, ["modular", str(config), "--out", str(tmp_path / "r"), "--name", "t",
-                                      "--budget", "30", "--refine", "3"])
+                                      "--budget", "30", "--refine", "3", "--refine-starts", "40"])
     assert result.exit_code == 0, result.output
     run = tmp_path / "r" / "modular" / "t"
     summary = pd.read_csv(run / "summary.csv")
@@ -156,7 +156,7 @@ def test_modular_command_writes_every_stage(tmp_path):
     assert 1 <= len(refined) <= 3
     nb = summary[summary["case"].isin(refined)]
     assert {"explore", "refine"} <= set(nb["stage"])  # coarse to fine (no screen on 12 waypoints), not the paper's
-    assert (nb[nb["stage"] == "explore"].groupby("case").size() == REFINE_STARTS).all()  # twice the default's starts
+    assert (nb[nb["stage"] == "explore"].groupby("case").size() == 40).all()  # --refine-starts reaches the search
     rows = summary[summary["case"].isin(screened) & (summary["tracks"].astype(str) == "True")]
     costs = rows.groupby("case")["design_cost"].min()
     table = pd.read_csv(run / "table.csv").set_index("stage")
@@ -211,7 +211,7 @@ def test_a_rounded_assignment_that_does_not_track_still_gets_the_neighbourhood_s
     cfg = parse_config({"name": "modular", "toolpath": {"kind": "figure_eight", "waypoints": 12},
                         "placement": {"xyz": [0.45, 0.0, -0.2]}, "search": {"preset": "paper", "starts": 1}})
     result = experiment.run_modular(cfg, tmp_path, "t", figures=False, jobs=1, neighbourhood_budget=8,
-                                    neighbourhood_refine=1)
+                                    neighbourhood_refine=1, neighbourhood_refine_starts=40)
     table = result.table.set_index("stage")
     assert not table.loc["modular", "tracks"] and np.isnan(table.loc["modular", "design_cost"])
     assert table.loc["neighbourhood", "tracks"] and np.isfinite(table.loc["neighbourhood", "design_cost"])
@@ -247,6 +247,7 @@ def test_the_swaps_flag_reaches_the_search(tmp_path, monkeypatch, flag, swaps):
     assert seen["neighbourhood_swaps"] is swaps
     if not flag:
         assert swaps is experiment.NEIGHBOURHOOD_SWAPS
+        assert seen["neighbourhood_refine_starts"] == experiment.REFINE_STARTS  # the CLI's default is the library's
 
 
 def test_mixed_structure_is_a_one_line_error(tmp_path):

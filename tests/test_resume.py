@@ -136,7 +136,8 @@ def test_waypoints_resumes(tmp_path):
 def test_modular_resumes(tmp_path):
     config = _setup(tmp_path, {"search": {"preset": "paper", "starts": 2}})
     out, run = tmp_path / "r", tmp_path / "r" / "modular" / "k"
-    args = ["modular", str(config), "--out", str(out), "--name", "k", "--budget", "12", "--refine", "2"]
+    args = ["modular", str(config), "--out", str(out), "--name", "k", "--budget", "12", "--refine", "2",
+            "--refine-starts", "40"]
     before = kill_part_way(args, run / "summary.csv")
     assert len(before) < 9, "the run was not killed part-way"
     _lose_first_file(run, before)

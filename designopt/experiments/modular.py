@@ -160,7 +160,8 @@ def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progre
                 figures: bool = True, resume: bool = False, jobs: int = -1, weight: float = WEIGHT,
                 neighbourhood_budget: int = NEIGHBOURHOOD_BUDGET, search: Search | None = None,
                 neighbourhood_refine: int = NEIGHBOURHOOD_REFINE,
-                neighbourhood_swaps: bool = NEIGHBOURHOOD_SWAPS) -> ModularResult:
+                neighbourhood_swaps: bool = NEIGHBOURHOOD_SWAPS,
+                neighbourhood_refine_starts: int = REFINE_STARTS) -> ModularResult:
     s = _setup(cfg, out_root, "modular", run_name, resume, jobs, progress, search)
     catalogue, run, base = s.catalogue, s.run, s.base
     best = {"continuous": _stage(s, base, "continuous")}
@@ -171,7 +172,8 @@ def run_modular(cfg: Config, out_root: Path, run_name: str | None = None, progre
     if continuous is not None and neighbourhood_budget:  # also when no start of the rounded assignment tracked
         searched, best["neighbourhood"], screened = _module_search(s, base, catalogue, placement, assignment, modular,
                                                                     neighbourhood_budget, refine=neighbourhood_refine,
-                                                                    swaps=neighbourhood_swaps)
+                                                                    swaps=neighbourhood_swaps,
+                                                                    refine_starts=neighbourhood_refine_starts)
         run.log(f"neighbourhood search: {screened} robots screened, best {[k + 1 for k in searched]}")
     if continuous is not None:
         best["rounded"] = rounded_solution(continuous, assignment, catalogue)
@@ -229,33 +231,33 @@ def module_screen(search: Search) -> Search:
     return preset("paper", starts=3, seed=search.seed, init="reach", profile=profile)
 
 
-def module_refine(search: Search) -> Search:
-    """How the neighbourhood search solves its best screened assignments on the full path: the default search
-    (coarse to fine; the search's seed) with `REFINE_STARTS` coarse starts, moved until they reach the path (no
-    second round on new joint branches, MUMPS in the exploration too, 12 screened once and one refine per candidate:
-    none of these measured on modular robots), as the enumeration that found the best modular robot known solved its
-    candidates (`benchmarks/modular_enumeration.py`). Every other setting is the default's as it stands
-    (`Search.describe` prints them); the default's additions of 2026-12-04 (the prescreen, the prescreened candidates
-    screened both ways, distinct arms refined, the relaxed pass for the best) were measured on modular robots after
-    they came in: the same spread over 20 fresh seeds as the search before them (docs/results.md, C7).
-    The config's own search (the ``paper`` preset's 4 cold starts in the shipped config) lost 1.3-1.5x on
-    assignments it shares with the enumeration; 80 coarse starts missed an assignment's own best on 3 of
-    7 evaluation seeds (1.24-1.41x where 160 starts reach 1.05x: docs/decisions.md)."""
-    return preset("default", seed=search.seed, init="reach", starts=REFINE_STARTS, rebranch=0, screen=12,
+def module_refine(search: Search, starts: int = REFINE_STARTS) -> Search:
+    """How the neighbourhood search solves its best screened assignments on the full path: the default search (coarse to
+    fine; the search's seed) with ``starts`` coarse starts (`REFINE_STARTS` unless a run asks for fewer), moved until
+    they reach the path (no second round on new joint branches, MUMPS in the exploration too, 12 screened once and one
+    refine per candidate: none of these measured on modular robots), as the enumeration that found the best modular
+    robot known solved its candidates (`benchmarks/modular_enumeration.py`). Every other setting is the default's as it
+    stands (`Search.describe` prints them); the default's additions of 2026-12-04 (the prescreen, the prescreened
+    candidates screened both ways, distinct arms refined, the relaxed pass for the best) were measured on modular robots
+    after they came in: the same spread over 20 fresh seeds as the search before them (docs/results.md, C7). The
+    config's own search (the ``paper`` preset's 4 cold starts in the shipped config) lost 1.3-1.5x on assignments it
+    shares with the enumeration; 80 coarse starts missed an assignment's own best on 3 of 7 evaluation seeds (1.24-1.41x
+    where 160 starts reach 1.05x: docs/decisions.md)."""
+    return preset("default", seed=search.seed, init="reach", starts=starts, rebranch=0, screen=12,
                   explore_linear_solver=None, screen_mu_init=(None,), refine_mu_init=(None,))
 
 
 def _module_search(setup, base, catalogue, placement, rounded, modular, budget, refine=NEIGHBOURHOOD_REFINE,
-                   swaps=NEIGHBOURHOOD_SWAPS):
+                   swaps=NEIGHBOURHOOD_SWAPS, refine_starts=REFINE_STARTS):
     """The neighbourhood stage: a local search over assignments on screening costs within ``budget`` screened robots,
     from the cheapest of the rounded assignment and a sample spread over the catalogue (a `NEIGHBOURHOOD_SAMPLE` share
     of the budget) on (``swaps``: a step also exchanges two neighbouring links' modules); then the ``refine`` best
-    distinct screening optima searched on the full path (`module_refine`). When the placement z is free and absorbs
-    lifts (`lifts_absorbed`), the assignments that build one robot up to a lift along base z are one robot: screened
-    once, solved with the placement z any of them could take (`lifted_range`), and reported as the one whose placement
-    lies in the box (`within_box`). Returns (best assignment, its solution, robots screened); never worse than the
-    rounded assignment's re-solve ``modular`` (None when none of its starts tracked: then the full-path search may solve
-    the rounded assignment again, if it is among the best screened)."""
+    distinct screening optima searched on the full path (`module_refine`, ``refine_starts`` coarse starts each). When
+    the placement z is free and absorbs lifts (`lifts_absorbed`), the assignments that build one robot up to a lift
+    along base z are one robot: screened once, solved with the placement z any of them could take (`lifted_range`), and
+    reported as the one whose placement lies in the box (`within_box`). Returns (best assignment, its solution, robots
+    screened); never worse than the rounded assignment's re-solve ``modular`` (None when none of its starts tracked:
+    then the full-path search may solve the rounded assignment again, if it is among the best screened)."""
     z = base.chain.joint("placement.z")
     absorbed = z.role is Role.DESIGN and lifts_absorbed(catalogue, (z.lower, z.upper))
     same = partial(same_robot, catalogue=catalogue) if absorbed else None
@@ -264,7 +266,8 @@ def _module_search(setup, base, catalogue, placement, rounded, modular, budget, 
     ranked, evaluated = screened_candidates(tuple(rounded), len(catalogue.modules), screen, budget,
                                             round(budget * NEIGHBOURHOOD_SAMPLE), refine, setup.search.seed, same,
                                             swaps)
-    full = ModuleCosts(setup, base, catalogue, placement, "nb-", module_refine(setup.search), absorbed=absorbed)
+    full = ModuleCosts(setup, base, catalogue, placement, "nb-", module_refine(setup.search, refine_starts),
+                       absorbed=absorbed)
     if modular is not None:
         full.best[tuple(rounded)] = modular  # already solved: the modular stage
     full(ranked)
