@@ -247,7 +247,10 @@ def test_the_swaps_flag_reaches_the_search(tmp_path, monkeypatch, flag, swaps):
     assert seen["neighbourhood_swaps"] is swaps
     if not flag:
         assert swaps is experiment.NEIGHBOURHOOD_SWAPS
-        assert seen["neighbourhood_refine_starts"] == experiment.REFINE_STARTS  # the CLI's default is the library's
+        # every default of the command is the library's
+        assert seen["neighbourhood_refine_starts"] == experiment.REFINE_STARTS
+        assert seen["neighbourhood_budget"] == experiment.NEIGHBOURHOOD_BUDGET
+        assert seen["neighbourhood_refine"] == experiment.NEIGHBOURHOOD_REFINE
 
 
 def test_mixed_structure_is_a_one_line_error(tmp_path):
