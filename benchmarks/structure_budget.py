@@ -63,8 +63,9 @@ def run(config: Path, structures: list[str], seeds: list[int], variants: list[st
                 if (structure, seed, name) in have:
                     continue
                 search = search_from_config(cfg)
-                if "preset" in fields:  # another preset's search, under the config's solver profile (fields: a
-                    search = replace(preset(str(fields.pop("preset"))), profile=search.profile)  # fresh dict)
+                # another preset's search, under the config's solver profile (`variant` parsed a fresh dict)
+                if "preset" in fields:
+                    search = replace(preset(str(fields.pop("preset"))), profile=search.profile)
                 search = replace(search, seed=seed, structure_neighbours=False, **fields)
                 cpu = 0.0
 
