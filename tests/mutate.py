@@ -747,7 +747,7 @@ MUTATIONS = [
              "for i in range(len(assignment) - 1) if assignment[i] != assignment[i + 1]]",
              "for i in range(len(assignment) - 1)]", ("tests/test_modular.py",)),
     Mutation("`designopt modular --swaps` does not reach the search", "cli/main.py",
-             "neighbourhood_swaps=swaps)", "neighbourhood_swaps=False)", ("tests/test_modular.py",)),
+             "neighbourhood_swaps=swaps,", "neighbourhood_swaps=False,", ("tests/test_modular.py",)),
     Mutation("the modular refinement solves copies of one screening optimum",
              "designopt/modular.py", "if not any(abs(c - kept) <= rel_tol * abs(kept) for _, kept in picked):",
              "if True:", ("tests/test_modular.py",)),
