@@ -29,8 +29,10 @@ $(CORPUS)/.extracted: $(STAMP)
 run: setup
 	$(BIN)/designopt run configs/milling.yaml
 
+# One pytest worker per core (pytest-xdist; a worker that runs dry takes tests from the other): the suite's long
+# end-to-end runs are single-threaded, so two cores halve its wall.
 test: setup corpus
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n auto --dist worksteal
 
 # The hypothesis fuzz of every config and CSV toolpath at >= 500 cases (see docs/testing.md).
 test-slow: setup

@@ -267,7 +267,15 @@ def small_config(tmp_path) -> Path:
 
 @pytest.fixture(scope="module", autouse=True)
 def shared_cache(tmp_path_factory):
+    """One compile cache for this module's processes (the CLI's workers and the killed subprocesses), given back
+    after it: the modules a pytest worker runs next keep the blocks the suite has compiled."""
+    before = os.environ.get("DESIGNOPT_CACHE")
     os.environ["DESIGNOPT_CACHE"] = str(tmp_path_factory.mktemp("cache"))
+    yield
+    if before is None:
+        del os.environ["DESIGNOPT_CACHE"]
+    else:
+        os.environ["DESIGNOPT_CACHE"] = before
 
 
 def sweep(config, out, *extra):
