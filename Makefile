@@ -30,7 +30,7 @@ run: setup
 	$(BIN)/designopt run configs/milling.yaml
 
 # One pytest worker per core (pytest-xdist; a worker that runs dry takes tests from the other): the suite's long
-# end-to-end runs are single-threaded, so two cores halve its wall.
+# end-to-end runs are single-threaded (on 2 cores 0.67x the wall of one worker: docs/benchmarks.md).
 test: setup corpus
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n auto --dist worksteal
 

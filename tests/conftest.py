@@ -20,6 +20,15 @@ from designopt.solve import Seeded, SolverProfile, solve_guess, solve_one
 # tests time nothing on. tests/test_tiered_compile.py turns them on where it tests them.
 os.environ["DESIGNOPT_TIER_UP_AFTER"] = "never"
 
+@pytest.fixture(scope="module")
+def module_compile_cache(tmp_path_factory):
+    """One compile cache (`DESIGNOPT_CACHE`) for a module's processes (the CLI's workers, killed subprocesses), given
+    back after the module: the modules a pytest worker runs next keep the blocks the suite has compiled."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("DESIGNOPT_CACHE", str(tmp_path_factory.mktemp("cache")))
+        yield
+
+
 # The configs the project ships (not benchmarks/search_seeds.py's per-seed copies beside them, `.bench-*.yaml`)
 SHIPPED_CONFIGS = sorted(p for p in (Path(__file__).resolve().parent.parent / "configs").glob("*.yaml")
                          if not p.name.startswith("."))

@@ -265,17 +265,7 @@ def small_config(tmp_path) -> Path:
     return path
 
 
-@pytest.fixture(scope="module", autouse=True)
-def shared_cache(tmp_path_factory):
-    """One compile cache for this module's processes (the CLI's workers and the killed subprocesses), given back
-    after it: the modules a pytest worker runs next keep the blocks the suite has compiled."""
-    before = os.environ.get("DESIGNOPT_CACHE")
-    os.environ["DESIGNOPT_CACHE"] = str(tmp_path_factory.mktemp("cache"))
-    yield
-    if before is None:
-        del os.environ["DESIGNOPT_CACHE"]
-    else:
-        os.environ["DESIGNOPT_CACHE"] = before
+pytestmark = pytest.mark.usefixtures("module_compile_cache")
 
 
 def sweep(config, out, *extra):
