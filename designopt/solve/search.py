@@ -39,141 +39,176 @@ def small_arm(moving_joints: int) -> bool:
 class Search:
     """A strategy and its budget. Counts are per problem; iteration caps per solve.
 
-    ``starts`` seeded starts (from ``seed``; designs by ``spread``: perturbed by ``perturbation``, drawn from the
-    task's box, or mixed, odd starts from the box, `designopt.initial_guess`; joints by ``init``: ik, home, reach
-    or constant): cold starts on
-    the full path for ``multistart``; for ``coarse_to_fine`` the exploration's starts on ``explore_waypoints`` of
-    the path's waypoints (each capped at ``explore_max_iter``), then the ``rebranch`` best distinct of their optima
-    (at most ``rebranch_per_form`` of one form, the pattern of the arm's joint axes, before other forms:
-    `optima.distinct_best`; None: by cost alone), and the cheapest of each of up to ``rebranch_new_forms`` forms
-    not among them, each started again ``starts // rebranch`` times (at least once; ``rebranch_shares``: the
-    leader of rank k as many times as its k-th entry, where there is one: `leader_starts`) on
-    a new joint branch (the optimum's design, first joints drawn over the whole circle:
-    `designopt.solve.starts.Rebranched`; 0: none), explored alike (``rebranch_rounds`` > 1: that many such rounds,
-    each from the best of every round before it, sharing ``starts // rebranch`` per leader; ``rebranch_pool`` > 1:
-    a leader's starts taken from that many times as many drawn, spread over the branches where their walks reach
-    the path's first waypoint, `starts.spread_branches`; ``rebranch_extra`` > 0: that many starts more per leader,
-    spread over the branches its drawn ones miss, out of ``rebranch_extra_pool`` drawn in a block of their own,
-    `more_start`; ``rebranch_extra_perturbation`` > 0: those with the design moved around the leader's by that
-    scale, x 0.5 m for lengths and x pi for angles, `starts.Rebranched`; ``rebranch_extra_snap``: those from the
-    leader's design with its arm's angles (twists) at the nearest multiple of pi/2, the idealised arm of its form
-    (`optima.snapped_design`), before any move; ``rebranch_moved`` > 0: that many starts
-    more again per leader, their designs moved around the leader's by ``rebranch_moved_perturbation``, spread over
-    the branches all the leader's other starts miss, out of ``rebranch_moved_pool`` drawn in a block of their own,
-    `more_start`; both are `more_blocks`); the
-    ``screen`` best distinct of both rounds (at most ``screen_per_form`` of one form before other forms; None: by
-    cost alone) are re-ranked on ``screen_waypoints`` (capped at ``screen_max_iter``; skipped when the path has no
-    more waypoints), with the cheapest distinct optimum of each of up to ``screen_new_leaders`` second-round leaders
-    whose starts have none among them (`leader_of`), and with
-    ``prescreen`` > 0 the ``prescreen_keep`` best of the ``prescreen`` next distinct coarse optima solved warm on
-    ``prescreen_waypoints`` as the screen's first pass solves (stage ``prescreen``; skipped when the screen's
-    waypoints are no more: `strategies.coarse_to_fine.best_prescreened`), each screened from its coarse optimum
-    (``screen_prescreened`` "coarse"), from its prescreened optimum ("prescreened": 10, 20, then 40 waypoints), or
-    both ways ("both": the prescreened optima in screen passes of their own, the candidate's best pass kept), and the
-    ``refine`` best distinct of those solved on the full path. Designs within ``distinct`` (m or rad) in every
-    design joint are one optimum; with ``same_arm_cost``, so are two whose arms (every design joint but the
-    placement's) lie within ``distinct`` and whose design costs within that fraction of the cheaper's: the same arm
-    placed elsewhere (a path's symmetry turns a placement about a circle's axis; a flat valley slides it), one
-    leader, candidate or reflected optimum, not several (`optima.cluster_designs`). ``hold_degenerate``: a solve
-    stalled on a degenerate design is finished with the design held there (`strategies.continuation`).
-    ``structure_neighbours``: after the strategy, one more start per problem from each neighbouring structure's
-    better design (`strategies.neighbours`; problems whose
-    structures differ in one joint's type, or by one joint, are neighbours). ``profile``: the full-path solves'
-    solver profile; ``explore_linear_solver``: the exploration's linear solver instead of the profile's (None: the
-    profile's; `SolverProfile.linear_solver`); ``explore_objective_scale``: the factor the exploration's solves (both
-    rounds) scale the objective by while they iterate (`SolverProfile.objective_scale`; 1: none);
-    ``screen_linear_solver``: the screen's, each candidate screened once by each of them (and each barrier of
-    ``screen_mu_init``: `screen_passes`). Two settings for a small arm (fewer
-    than `SMALL_ARM` moving joints, `small_arm`): ``small_arm_screens_once``, its candidates screened by the first
-    of those passes only (a small arm's passes end in one basin; `passes_for`); ``small_arm_perturbation``, the
-    ``perturbation`` of its exploration's seeded starts (None: ``perturbation``; `perturbation_for`).
-    ``refine_mu_init``: the barrier parameters the refine's warm solves start from (IPOPT's ``mu_init``; None: the
-    warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate refined once per value (stages
-    ``refine``, ``refine2``, ...; the answer is the best of all): from a small one a refine stays in the basin its
-    screened start is in, from the warm start's it sometimes walks into a better one and more often into a worse
-    one. ``refine_from_coarse``: each refined candidate refined once more, from its coarse optimum lifted straight
-    to the full path and solved warm from the warm start's barrier (the stage after the barriers' passes, e.g.
-    ``refine3``): a screened solution fits the screen's waypoints and may leave the path between them by more than
-    the velocity limits allow, so its lift can start outside its basin. ``refine_relaxed``: each of that many best
-    refined candidates (0: none) whose lifted start steps further than the velocity limits allow (by r, the largest
-    step over v_max h) refined once more through relaxed limits: solved warm with every velocity limit times 1.05 r
-    (stage ``relax``), then times sqrt(1.05 r) from barrier 1e-6 (``relax2``), then at the limits from 1e-6 (the
-    stage after the other refines); the relaxed solves are not answers. ``refine_distinct_arms``: the refine's
-    ``refine`` candidates distinct arms whichever way their joint axes point: with ``same_arm_cost``, a candidate
-    whose arm is a cheaper one's written otherwise (`optima.arm_invariants`: lengths by size, twists as angles
-    between lines; a DH arm's reflections, its twists turned by pi about zero offsets) at a screen cost within that
-    fraction is that candidate, and the next distinct arm takes its place. ``screen_mu_init``: the same as
-    ``refine_mu_init`` for the screen (stages ``screen``, ``screen2``, ...), each candidate ranked for the refine by
-    its better pass. ``hop``: after the
-    strategy and the neighbour step, that many restarts around each of the ``hop_incumbents`` best distinct
-    full-path optima, on a new joint branch with the design moved by ``hop_perturbation`` (as
-    ``rebranch_extra_perturbation``), solved on the screen's waypoints (stage ``hop``), the ``hop_refine`` best
-    distinct of them refined on the full path (stage ``hop_full``; `strategies.hop`); 0: none. ``reflect``: after
-    the hop step, up to this many rounds (stages ``reflect``, ``reflect2``, ...) in which each
-    problem's best full-path solution is reflected across the length bounds it lies at (the same arm with that
-    length's sign flipped) and solved warm (`strategies.reflect`); 0: none. ``reflect_within``: the first round
-    reflects every distinct full-path optimum whose design cost is within this factor of the problem's best, not
-    the best alone (None: the best alone). ``small_problem_starts``: in a search
-    of several problems (a sweep's structures), a problem with fewer unknowns than the largest gets more exploration
-    starts, as many as cost about what the largest one's ``starts`` cost, at most this many times ``starts``
-    (`strategies.coarse_to_fine.exploration_starts`), and screens as many times more candidates on as many more
-    waypoints as keep its screen the largest one's size (`strategies.coarse_to_fine.screening`); 1: every problem
-    ``starts``, ``screen`` and ``screen_waypoints``.
+    ``multistart``: ``starts`` seeded cold starts on the full path. ``coarse_to_fine``, stage by stage (each
+    field's comment says what it sets; the stage names are those of a run's ``summary.csv``):
+
+    1. ``explore``: ``starts`` seeded starts on ``explore_waypoints`` of the path's waypoints, then a second round
+       on new joint branches from the best distinct coarse optima (the leaders), explored alike;
+    2. ``prescreen``: the next-best distinct coarse optima solved warm on ``prescreen_waypoints``, the best kept;
+    3. ``screen``: the best distinct coarse optima (and the kept prescreened ones) re-ranked on
+       ``screen_waypoints``, once per pass (`screen_passes`);
+    4. ``refine``: the best distinct screened optima solved on the full path, once per barrier of
+       ``refine_mu_init``, the best ones once more through relaxed velocity limits (``relax``);
+    5. after the strategy, for either: a start from each neighbouring structure's better design, restarts around
+       the best (``hop``), reflections across length bounds (``reflect``).
+
+    Designs within ``distinct`` (m or rad) in every design joint are one optimum (`optima.cluster_designs`); a form
+    is the pattern of an arm's joint axes (`optima.distinct_best`). Settings that were measured and not adopted by
+    any preset (docs/decisions.md says what each did) are kept as options: a variant is judged by setting them.
     """
 
+    # -- the starts ---------------------------------------------------------------------------------------------
+    #: ``coarse_to_fine`` (`strategies.coarse_to_fine`) or ``multistart`` (`strategies.multistart`).
     strategy: str = "coarse_to_fine"
+    #: Seeded starts of the exploration (``multistart``: on the full path).
     starts: int = 80
+    #: The seed the starts are numbered and drawn from (`initial_guess.start_number`).
     seed: int = 0
+    #: How far a perturbed start's design moves from the configured one: x 0.5 m for lengths, x pi for angles.
     perturbation: float = 0.3
+    #: How seeded starts spread their designs: ``perturb`` (by ``perturbation``), ``box`` (drawn from the task's
+    #: box, `initial_guess.box_design`) or ``mixed`` (odd starts from the box).
     spread: str = "perturb"
+    #: How a start's joints reach the path: ``ik``, ``home`` (the IK walk pulled towards the first waypoint's
+    #: configuration), ``reach`` or ``constant`` (`designopt.initial_guess`).
     init: str = "ik"
+
+    # -- the exploration ----------------------------------------------------------------------------------------
+    #: Waypoints of the exploration's coarse path.
     explore_waypoints: int = 10
+    #: Iteration cap of each exploration solve (both rounds).
     explore_max_iter: int = 250
+    #: The exploration's linear solver instead of the profile's (None: the profile's; `SolverProfile.linear_solver`).
+    explore_linear_solver: str | None = None
+    #: Factor the exploration's solves scale the objective by while they iterate (`SolverProfile.objective_scale`;
+    #: 1: none).
+    explore_objective_scale: float = 1.0
+
+    # -- the second round on new joint branches (`strategies.coarse_to_fine`, `starts.Rebranched`) ---------------
+    #: Leaders: the best distinct coarse optima restarted on new joint branches (the optimum's design, first joints
+    #: drawn over the whole circle), ``starts // rebranch`` times each (`rebranch_starts`; at least once); 0: none.
     rebranch: int = 8
+    #: At most this many leaders of one form before other forms (None: by cost alone).
     rebranch_per_form: int | None = None
+    #: Also the cheapest optimum of each of up to this many forms not among the leaders.
     rebranch_new_forms: int = 0
+    #: The leader of rank k restarted as many times as its k-th entry, where there is one (`leader_starts`).
     rebranch_shares: tuple[int, ...] | None = None
+    #: Rounds on new joint branches, each from the best of every round before it, sharing ``starts // rebranch``
+    #: per leader.
     rebranch_rounds: int = 1
+    #: > 1: a leader's starts taken from this many times as many drawn, spread over the branches where their walks
+    #: reach the path's first waypoint (`starts.spread_branches`).
     rebranch_pool: int = 1
+    #: Starts more per leader, spread over the branches its drawn ones miss, out of ``rebranch_extra_pool`` drawn
+    #: in a block of their own (`more_start`).
     rebranch_extra: int = 0
     rebranch_extra_pool: int = 40
+    #: > 0: the extras' designs moved around the leader's by this scale (as ``perturbation``).
     rebranch_extra_perturbation: float = 0.0
+    #: The extras from the leader's design with its arm's angles (twists) at the nearest multiple of pi/2, the
+    #: idealised arm of its form (`optima.snapped_design`), before any move.
     rebranch_extra_snap: bool = False
+    #: Starts more again per leader, their designs moved around the leader's by ``rebranch_moved_perturbation``,
+    #: spread over the branches all its other starts miss, out of ``rebranch_moved_pool`` drawn (`more_blocks`).
     rebranch_moved: int = 0
     rebranch_moved_pool: int = 20
     rebranch_moved_perturbation: float = 0.1
+
+    # -- the screen and its prescreen (`strategies.coarse_to_fine.best_prescreened`) ----------------------------
+    #: Waypoints the candidates are re-ranked on (skipped when the path has no more than this).
     screen_waypoints: int = 40
+    #: Candidates: the best distinct optima of both rounds.
     screen: int = 12
+    #: At most this many candidates of one form before other forms (None: by cost alone).
     screen_per_form: int | None = None
+    #: Also the cheapest distinct optimum of each of up to this many second-round leaders whose starts have none
+    #: among the candidates (`leader_of`).
     screen_new_leaders: int = 0
+    #: Iteration cap of each screen solve.
     screen_max_iter: int = 300
+    #: > 0: the next this-many distinct coarse optima solved warm on ``prescreen_waypoints`` as the screen's first
+    #: pass solves (stage ``prescreen``; skipped when the screen's waypoints are no more), the best
+    #: ``prescreen_keep`` of them screened too.
     prescreen: int = 0
     prescreen_keep: int = 8
     prescreen_waypoints: int = 20
+    #: How a prescreened candidate is screened: from its ``coarse`` optimum, from its ``prescreened`` optimum
+    #: (10, 20, then 40 waypoints), or ``both`` (screen passes of their own; the candidate's best pass kept).
     screen_prescreened: str = "coarse"
-    refine: int = 4
-    distinct: float = 0.02
-    same_arm_cost: float | None = None
-    hold_degenerate: bool = True
-    structure_neighbours: bool = True
-    profile: SolverProfile = field(default_factory=SolverProfile)
-    explore_linear_solver: str | None = None
-    explore_objective_scale: float = 1.0
+    #: The screen's linear solvers: each candidate screened once by each (None: the profile's; `screen_passes`).
     screen_linear_solver: tuple[str | None, ...] = (None,)
+    #: The screen's barriers (IPOPT's ``mu_init``; None: the warm start's): each candidate screened once from
+    #: each (stages ``screen``, ``screen2``, ...), ranked for the refine by its better pass.
     screen_mu_init: tuple[float | None, ...] = (None,)
-    small_arm_screens_once: bool = False
-    small_arm_perturbation: float | None = None
+
+    # -- the refine on the full path (solver profile ``profile``) ------------------------------------------------
+    #: Distinct screened optima refined on the full path.
+    refine: int = 4
+    #: The refine's barriers (None: the warm start's own, 1e-4, `designopt.solve.backends.ipopt`), each candidate
+    #: refined once per value (stages ``refine``, ``refine2``, ...; the answer is the best of all): from a small one
+    #: a refine stays in its screened start's basin, from the warm start's it sometimes walks into a better one and
+    #: more often into a worse one.
     refine_mu_init: tuple[float | None, ...] = (None,)
+    #: Each refined candidate refined once more from its coarse optimum lifted straight to the full path, warm from
+    #: the warm start's barrier (the stage after the barriers' passes): a screened solution fits the screen's
+    #: waypoints and may leave the path between them faster than the velocity limits allow.
     refine_from_coarse: bool = False
+    #: Each of this many best refined candidates (0: none) whose lifted start steps further than the velocity limits
+    #: allow (by r, the largest step over v_max h) refined once more through relaxed limits: warm with every limit
+    #: times 1.05 r (stage ``relax``), times sqrt(1.05 r) from barrier 1e-6 (``relax2``), then at the limits from
+    #: 1e-6 (the stage after the other refines); the relaxed solves are not answers.
     refine_relaxed: int = 0
+    #: The refine's candidates distinct arms whichever way their joint axes point: with ``same_arm_cost``, a
+    #: candidate whose arm is a cheaper one's written otherwise (`optima.arm_invariants`: lengths by size, twists as
+    #: angles between lines; a DH arm's reflections, its twists turned by pi about zero offsets) at a screen cost
+    #: within that fraction is that candidate, and the next distinct arm takes its place.
     refine_distinct_arms: bool = False
-    reflect: int = 0
-    reflect_within: float | None = None
+    #: The full-path solves' solver profile (the exploration's and the screen's derive from it).
+    profile: SolverProfile = field(default_factory=SolverProfile)
+
+    # -- what makes two optima one ------------------------------------------------------------------------------
+    #: Designs within this (m or rad) in every design joint are one optimum.
+    distinct: float = 0.02
+    #: Two designs whose arms (every design joint but the placement's) lie within ``distinct`` and whose design
+    #: costs within this fraction of the cheaper's are one optimum too: the same arm placed elsewhere (a path's
+    #: symmetry turns a placement about a circle's axis; a flat valley slides it). None: off.
+    same_arm_cost: float | None = None
+
+    # -- after the strategy (`strategies.continuation`, `strategies.neighbours`, `strategies.hop`,
+    #    `strategies.reflect`) -------------------------------------------------------------------------------------
+    #: A solve stalled on a degenerate design is finished with the design held there.
+    hold_degenerate: bool = True
+    #: One more start per problem from each neighbouring structure's better design (structures that differ in one
+    #: joint's type, or by one joint, are neighbours).
+    structure_neighbours: bool = True
+    #: Restarts around each of the ``hop_incumbents`` best distinct full-path optima, on a new joint branch with the
+    #: design moved by ``hop_perturbation`` (as ``perturbation``), solved on the screen's waypoints (stage ``hop``),
+    #: the ``hop_refine`` best distinct of them refined on the full path (stage ``hop_full``); 0: none.
     hop: int = 0
     hop_incumbents: int = 2
     hop_perturbation: float = 0.1
     hop_refine: int = 6
+    #: Rounds (stages ``reflect``, ``reflect2``, ...) in which each problem's best full-path solution is reflected
+    #: across the length bounds it lies at (the same arm with that length's sign flipped) and solved warm; 0: none.
+    reflect: int = 0
+    #: The first round reflects every distinct full-path optimum within this factor of the problem's best (None: the
+    #: best alone).
+    reflect_within: float | None = None
+
+    # -- a search of several problems (a sweep's structures) ----------------------------------------------------
+    #: Small arms (fewer than `SMALL_ARM` moving joints, `small_arm`): screened by the first pass only
+    #: (`passes_for`; a small arm's passes end in one basin).
+    small_arm_screens_once: bool = False
+    #: Small arms' ``perturbation`` (None: ``perturbation``; `perturbation_for`).
+    small_arm_perturbation: float | None = None
+    #: A problem with fewer unknowns than the largest gets as many exploration starts as cost about what the
+    #: largest one's ``starts`` cost, at most this many times ``starts`` (`exploration_starts`), and screens as many
+    #: times more candidates on as many more waypoints as keep its screen the largest one's size (`screening`;
+    #: both in `strategies.coarse_to_fine`); 1: every problem ``starts``, ``screen`` and ``screen_waypoints``.
     small_problem_starts: float = 1.0
+
+    #: Independent draws of the whole search (`draw_seeds`), the answer the best of them.
     draws: int = 1
 
     def __post_init__(self):
