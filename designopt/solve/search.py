@@ -175,22 +175,23 @@ class Search:
     #: symmetry turns a placement about a circle's axis; a flat valley slides it). None: off.
     same_arm_cost: float | None = None
 
-    # -- after the strategy (`strategies.continuation`, `strategies.neighbours`, `strategies.hop`,
-    #    `strategies.reflect`) -------------------------------------------------------------------------------------
-    #: A solve stalled on a degenerate design is finished with the design held there.
+    # -- after the strategy -------------------------------------------------------------------------------------
+    #: A solve stalled on a degenerate design is finished with the design held there (`strategies.continuation`).
     hold_degenerate: bool = True
     #: One more start per problem from each neighbouring structure's better design (structures that differ in one
-    #: joint's type, or by one joint, are neighbours).
+    #: joint's type, or by one joint, are neighbours; `strategies.neighbours`).
     structure_neighbours: bool = True
     #: Restarts around each of the ``hop_incumbents`` best distinct full-path optima, on a new joint branch with the
     #: design moved by ``hop_perturbation`` (as ``perturbation``), solved on the screen's waypoints (stage ``hop``),
-    #: the ``hop_refine`` best distinct of them refined on the full path (stage ``hop_full``); 0: none.
+    #: the ``hop_refine`` best distinct of them refined on the full path (stage ``hop_full``; `strategies.hop`);
+    #: 0: none.
     hop: int = 0
     hop_incumbents: int = 2
     hop_perturbation: float = 0.1
     hop_refine: int = 6
     #: Rounds (stages ``reflect``, ``reflect2``, ...) in which each problem's best full-path solution is reflected
-    #: across the length bounds it lies at (the same arm with that length's sign flipped) and solved warm; 0: none.
+    #: across the length bounds it lies at (the same arm with that length's sign flipped) and solved warm
+    #: (`strategies.reflect`); 0: none.
     reflect: int = 0
     #: The first round reflects every distinct full-path optimum within this factor of the problem's best (None: the
     #: best alone).
