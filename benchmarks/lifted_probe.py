@@ -44,9 +44,10 @@ from designopt.experiments.adapters import search_from_config  # noqa: E402
 from designopt.initial_guess import initial_guess  # noqa: E402
 from designopt.problem import problem_from_config  # noqa: E402
 from designopt.solve.backends import ipopt as ipopt_backend  # noqa: E402
+from designopt.solve.profile import SolverProfile  # noqa: E402
 from designopt.solve.strategies.coarse_to_fine import coarse_problem  # noqa: E402
 from designopt.transcriptions import Collocation  # noqa: E402
-from designopt.transcriptions.nlp import tracking, waypoint_inputs  # noqa: E402
+from designopt.transcriptions.nlp import tracking, waypoint_inputs, y_indices  # noqa: E402
 from designopt.transcriptions.quadratic import total  # noqa: E402
 
 PlainWalk = chain_module.Walk
@@ -61,7 +62,7 @@ class Lifting:
         self.symbols, self.definitions, self._seen = [], [], {}
 
     def lift(self, M):
-        if not isinstance(M, ca.SX) or ca.SX(M).is_constant() or not ca.symvar(ca.SX(M)):
+        if not isinstance(M, ca.SX) or not ca.symvar(M):
             return M
         key = str(M)
         if key not in self._seen:
@@ -92,7 +93,8 @@ def lifted_walk(lifting: Lifting):
 
 def lifted_terms(problem):
     """(y, L, s_W, f_W, k_w) -> (phi, c, L - D(y, L)): `nlp.waypoint_terms` of hard tracking with the frames lifted,
-    and the residual of the lifting's definitions; also the number of lifted entries."""
+    and the residual of the lifting's definitions; also the number of lifted entries. A copy of that function's
+    body: its terms take the lifted frames as an input, which the library's cannot (no free symbols in a Function)."""
     chain, tp = problem.chain, problem.toolpath
     n_m, n_d = chain.n_moving, chain.n_design
     y = ca.SX.sym("y", n_m + n_d)
@@ -109,15 +111,14 @@ def lifted_terms(problem):
     for cost in problem.design_costs:
         if not cost.quadratic:
             phi += cost(chain, y[n_m:]) / tp.n
-    _, c, lo, hi = tracking(w, s_W, "hard", k_w[0] * problem.tracking_weight, True, 0.0)
+    # the rows in the library's order; their bounds are the direct NLP's (`LiftedNLP`)
+    _, c, _, _ = tracking(w, s_W, "hard", k_w[0] * problem.tracking_weight, True, 0.0)
     if problem.keep_out_radius > 0:
         s_B = w.T_BW[:3, :3] @ s_W + w.T_BW[:3, 3]
         c.append(s_B[0] ** 2 + s_B[1] ** 2)
-        lo.append(problem.keep_out_radius**2)
-        hi.append(np.inf)
     L, D = ca.vertcat(*lifting.symbols), ca.vertcat(*lifting.definitions)
     fn = ca.Function("lifted_terms", [y, L, s_W, f_W, k_w], [phi, ca.vertcat(*c), L - D])
-    return fn, L.shape[0], np.array(lo), np.array(hi)
+    return fn, L.shape[0]
 
 
 class LiftedNLP:
@@ -127,16 +128,14 @@ class LiftedNLP:
     def __init__(self, problem, direct):
         chain, tp = problem.chain, problem.toolpath
         n_m, n_d, N = chain.n_moving, chain.n_design, tp.n
-        terms, self.n_lift, c_lo, c_hi = lifted_terms(problem)
+        terms, self.n_lift = lifted_terms(problem)
         nlp = direct.nlp
         x_direct = nlp.x
         Lall = ca.SX.sym("L", self.n_lift, N)
         self.x = ca.vertcat(x_direct, ca.vec(Lall))
-        stride = direct.n_state
-        Q = ca.horzcat(*[x_direct[n_d + k * stride : n_d + k * stride + n_m] for k in range(N)])
-        q_d = x_direct[:n_d]
-        S, F, K_w = waypoint_inputs(tp)
-        phi, C, R = terms.map(N)(ca.vertcat(Q, ca.repmat(q_d, 1, N)), Lall, S, F, K_w)
+        self.y_index = y_indices(n_d, n_m, N, direct.n_state)  # x-indices of y_k = (q_k, q_d), one row a waypoint
+        Y = ca.horzcat(*[x_direct[list(row)] for row in self.y_index])
+        phi, C, R = terms.map(N)(Y, Lall, *waypoint_inputs(tp))
         self.f = ca.sum2(phi) + total(nlp.quadratic, x_direct)
         n_c = C.shape[0]
         rest = nlp.g[n_c * N :]
@@ -146,47 +145,48 @@ class LiftedNLP:
         self.ubg = np.concatenate([nlp.ubg[: n_c * N], np.zeros(self.n_lift * N), nlp.ubg[n_c * N :]])
         self.lbx = np.concatenate([nlp.lbx, -np.inf * np.ones(self.n_lift * N)])
         self.ubx = np.concatenate([nlp.ubx, np.inf * np.ones(self.n_lift * N)])
-        self.n_direct, self.N = x_direct.shape[0], N
+        self.N = N
         # the frames at a direct point: the definitions iterated to their fixed point (each frame depends on the
         # one before it, so as many passes as frames)
         y = ca.SX.sym("y", n_m + n_d)
         L = ca.SX.sym("L", self.n_lift)
         residual = terms(y, L, ca.DM.zeros(3), ca.DM.zeros(3), ca.DM.ones(2))[2]
         self._define = ca.Function("define", [y, L], [L - residual])
-        self.terms, self.n_c = terms, n_c
+        self.n_c = n_c
 
-    def lift(self, problem, direct, x0: np.ndarray) -> np.ndarray:
-        n_m, n_d, N = problem.chain.n_moving, problem.chain.n_design, self.N
-        stride = direct.n_state
+    def lift(self, x0: np.ndarray) -> np.ndarray:
+        """The decision vector of a direct point ``x0``, its frames at their values there."""
         frames = []
-        for k in range(N):
-            y = np.concatenate([x0[n_d + k * stride : n_d + k * stride + n_m], x0[:n_d]])
+        for row in self.y_index:
             L = np.zeros(self.n_lift)
             for _ in range(self.n_lift // 12 + 1):
-                L = np.asarray(self._define(y, L)).ravel()
+                L = np.asarray(self._define(x0[row], L)).ravel()
             frames.append(L)
-        return np.concatenate([x0, np.column_stack(frames).T.ravel()])
+        return np.concatenate([x0, np.concatenate(frames)])
 
 
-def solve(x, f, g, lbx, ubx, lbg, ubg, x0, max_iter, log: Path, extra: dict):
-    opts = ipopt_backend.options(_Profile(max_iter), x.shape[0]) | extra
-    opts |= {"ipopt.output_file": str(log), "ipopt.file_print_level": 5, "ipopt.print_level": 0}
-    solver = ca.nlpsol("probe", "ipopt", {"x": x, "f": f, "g": g}, opts)
-    cpu = time.process_time()
-    sol = solver(x0=x0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
-    seconds = time.process_time() - cpu
-    stats = solver.stats()
-    corrected, counted = corrected_share(log.read_text(errors="replace"))
-    share = corrected / max(counted, 1)
-    return np.asarray(sol["x"]).ravel(), stats["return_status"], stats["iter_count"], seconds, share
+class Form:
+    """One form's IPOPT solver, built once with the exploration's options (MUMPS, cold, capped) and the ``extra``
+    ones; IPOPT appends every solve's log to one file, and each solve reads its own part (as `iteration_split`)."""
 
+    def __init__(self, nlp, max_iter: int, log: Path, extra: dict):
+        self.nlp, self.log = nlp, log
+        opts = ipopt_backend.options(SolverProfile(max_iter=max_iter, linear_solver="mumps"), nlp.x.shape[0]) | extra
+        opts |= {"ipopt.output_file": str(log), "ipopt.file_print_level": 5, "ipopt.print_level": 0}
+        self.solver = ca.nlpsol("probe", "ipopt", {"x": nlp.x, "f": nlp.f, "g": nlp.g}, opts)
 
-class _Profile:
-    """The exploration's solver settings (`ipopt.options` reads these fields): MUMPS, cold, capped."""
-
-    def __init__(self, max_iter):
-        self.max_iter, self.time_limit, self.linear_solver = max_iter, 300.0, "mumps"
-        self.objective_scale, self.warm, self.options = 1.0, False, ()
+    def solve(self, x0: np.ndarray):
+        """(x, status, iterations, CPU seconds, share of inertia-corrected iterations) of a solve from ``x0``."""
+        nlp, before = self.nlp, self.log.stat().st_size if self.log.exists() else 0
+        cpu = time.process_time()
+        sol = self.solver(x0=x0, lbx=nlp.lbx, ubx=nlp.ubx, lbg=nlp.lbg, ubg=nlp.ubg)
+        seconds = time.process_time() - cpu
+        with open(self.log, "rb") as fh:
+            fh.seek(before)
+            corrected, counted = corrected_share(fh.read().decode(errors="replace"))
+        stats = self.solver.stats()
+        return (np.asarray(sol["x"]).ravel(), stats["return_status"], stats["iter_count"], seconds,
+                corrected / max(counted, 1))
 
 
 def main() -> None:
@@ -214,10 +214,12 @@ def main() -> None:
     f_lifted = ca.Function("fl", [lifted.x], [lifted.f, lifted.g])
     rows = {"direct": [], "lifted": []}
     with tempfile.TemporaryDirectory() as tmp:
+        forms = {name: Form(form, args.max_iter, Path(tmp) / f"{name}.log", extra)
+                 for name, form in (("direct", nlp), ("lifted", lifted))}
         for start in range(args.first_start, args.first_start + args.starts):
             guess = initial_guess(problem, start, search.seed, search.perturbation, search.init)
             x0 = direct.pack(guess)
-            xl0 = lifted.lift(problem, direct, x0)
+            xl0 = lifted.lift(x0)
             fd, gd = (np.asarray(v).ravel() for v in f_direct(x0))
             fl, gl = (np.asarray(v).ravel() for v in f_lifted(xl0))
             n = lifted.n_c * lifted.N
@@ -228,12 +230,8 @@ def main() -> None:
                 raise SystemExit(f"start {start}: the lifted NLP differs from the direct one at the start "
                                  f"(f {fd[0]:.6e} vs {fl[0]:.6e}, rows {np.abs(gd - other).max():.1e}, "
                                  f"definitions {np.abs(definitions).max():.1e})")
-            for name, (x, f, g, lbx, ubx, lbg, ubg, start_x) in {
-                "direct": (nlp.x, nlp.f, nlp.g, nlp.lbx, nlp.ubx, nlp.lbg, nlp.ubg, x0),
-                "lifted": (lifted.x, lifted.f, lifted.g, lifted.lbx, lifted.ubx, lifted.lbg, lifted.ubg, xl0),
-            }.items():
-                x_end, status, iterations, seconds, corrected = solve(
-                    x, f, g, lbx, ubx, lbg, ubg, start_x, args.max_iter, Path(tmp) / f"{name}{start}.log", extra)
+            for name, start_x in (("direct", x0), ("lifted", xl0)):
+                x_end, status, iterations, seconds, corrected = forms[name].solve(start_x)
                 q_d, trajectory, _ = direct.unpack(x_end[: nlp.n_variables])
                 metrics = evaluate(problem, q_d, trajectory)
                 rows[name].append((start, status, iterations, corrected, 1e3 * seconds / max(iterations, 1),
