@@ -58,6 +58,7 @@ from designopt.solve.strategies.coarse_to_fine import (
     exploration_starts,
     rebranched_tasks,
     screening,
+    shares,
 )
 from designopt.solve.strategies.steps import seeded_tasks
 from designopt.solve.tasks import units
@@ -92,7 +93,8 @@ def test_the_config_names_a_preset_and_every_knob_reaches_the_search():
     assert preset("quick", seed=2) == Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4,
                                              reflect=3, small_problem_starts=4, seed=2, explore_linear_solver="ldl",
                                              screen_linear_solver=("ldl", "mumps"), small_arm_screens_once=True,
-                                             small_arm_perturbation=0.6, profile=PRESETS["quick"].profile)
+                                             small_arm_perturbation=0.6, small_arm_starts=2,
+                                             profile=PRESETS["quick"].profile)
     # a stage's own linear solver is named in the search's words, the profile's is not
     quick = PRESETS["quick"].describe()
     assert ("20 waypoints (<= 300 iterations, each candidate once with KKT systems by ldl and once by mumps; an arm of "
@@ -936,6 +938,34 @@ def test_a_smaller_problem_of_a_batch_gets_more_exploration_starts():
     rebranched = rebranched_tasks([[(explore[0], sol)]], replace(more, rebranch=1))
     assert [t.start.index for t in rebranched] == list(range(160, 200))
     assert all(more.second_round(t.seed) for t in rebranched)
+
+
+def test_a_small_arm_gets_more_exploration_starts_but_the_screen_of_its_share():
+    """`Search.small_arm_starts`: an arm of fewer than `SMALL_ARM` moving joints explores with that many times its
+    share of the batch's starts (`coarse_to_fine.shares`), a larger arm with its share; the screen stays the share's
+    (candidates and waypoints), the second round is numbered after the most any problem gets, and the plan explores
+    each problem with its count. Alone, a small arm gets that many times ``starts``."""
+    sweep = load_config(Path(__file__).parent.parent / "configs" / "structures.yaml")
+    rrr, rrrr, rrrrr, six = (problem_from_config(structure_config(sweep, s))
+                             for s in ("RRR", "RRRR", "RRRRR", "RRRRRR"))
+    base = Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, small_problem_starts=4)
+    more = replace(base, small_arm_starts=2)
+    assert shares([rrr, rrrr, rrrrr, six], more) == exploration_starts([rrr, rrrr, rrrrr, six], base) == [139, 84, 56,
+                                                                                                         40]
+    assert exploration_starts([rrr, rrrr, rrrrr, six], more) == [278, 168, 56, 40]
+    assert screening([rrr, rrrr, rrrrr, six], more) == screening([rrr, rrrr, rrrrr, six], base)
+    assert exploration_starts([rrrr], replace(more, small_problem_starts=1)) == [80]
+    assert exploration_starts([six], more) == [40]
+    assert more.most_starts == 320 and base.most_starts == 160
+    assert "2x as many for an arm of fewer than 5 joints" in more.describe()
+    assert "as many for an arm" not in base.describe()
+    jobs = [Job("", rrrr), Job("", six)]
+    more = replace(more, seed=5)
+    explore = next(coarse_to_fine.plan(jobs, more))
+    counts = {s: sum(t.problem.chain.structure == s for t in explore) for s in ("RRRR", "RRRRRR")}
+    assert counts == {"RRRR": 168, "RRRRRR": 40}
+    assert len({t.seed for t in explore if t.problem.chain.structure == "RRRR"}) == 168
+    assert not any(more.second_round(t.seed) for t in explore)
 
 
 def test_the_second_round_is_told_apart_past_a_thousand_starts():

@@ -280,8 +280,8 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
     assert set(summary["structure"]) == {"R", "P", "RR", "RP", "PR", "PP"}
     assert (summary["case"] == "sweep").all()
     stages = summary.groupby(["structure", "stage"]).size()
-    for s in ("RR", "RP", "PR", "PP"):  # every two-joint structure: 3 coarse starts, the best 4 refined
-        assert stages[s, "explore"] == 3 and stages.get((s, "refine"), 0) <= 3  # (of 3 coarse optima at most)
+    for s in ("RR", "RP", "PR", "PP"):  # every two-joint structure, a small arm: 2 x 3 starts, the best 4 refined
+        assert stages[s, "explore"] == 6 and stages.get((s, "refine"), 0) <= 4
     # a structure gets a neighbour's start exactly when a neighbour (one joint type changed, or one joint fewer)
     # searched its way to a cheaper design than its own, one start per such neighbour (and insertion)
     refined = summary[summary["stage"] == "refine"]
@@ -294,10 +294,11 @@ def test_sweep_1_to_2_dof_end_to_end(tmp_path):
     assert "6 structures solved" in result.output
     table = pd.read_csv(run / "table.csv")
     assert list(table["structure"]) == ["R", "P", "RR", "RP", "PR", "PP"]
-    # 3 coarse starts for two joints; one joint, whose starts cost less, gets 3 x (28 / 17)^2 = 8.1 of them (quick's
-    # `small_problem_starts`; n = joints x 8 waypoints + d or theta, a, alpha per link + 6 placement joints)
+    # a share of 3 coarse starts for two joints; one joint, whose starts cost less, a share of 3 x (28 / 17)^2 = 8.1
+    # (quick's `small_problem_starts`; n = joints x 8 waypoints + d or theta, a, alpha per link + 6 placement joints);
+    # every arm here small, so twice its share (quick's `small_arm_starts`)
     assert dict(zip(table["structure"], table["explore_starts"], strict=True)) == {
-        "R": 8, "P": 8, "RR": 3, "RP": 3, "PR": 3, "PP": 3}
+        "R": 16, "P": 16, "RR": 6, "RP": 6, "PR": 6, "PP": 6}
     refined = table[table["starts"] == 1]
     assert (refined["near_best"] == refined["tracking_starts"]).all()  # one full-path solve: it is its own best
     assert (table["near_best"] <= table["tracking_starts"]).all()
@@ -374,7 +375,7 @@ def test_killed_sweep_resumes_without_losing_or_repeating(tmp_path):
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
     before = pd.read_csv(summary)
-    assert 3 <= len(before) < 8 * 3 + 4 * 6 + 2 * 12, "the sweep was not killed part-way"
+    assert 3 <= len(before) < 8 * 6 + 4 * 12 + 2 * 24, "the sweep was not killed part-way"
     kept = {f: _digest(out / "structures" / "k" / f) for f in before["solution_file"]}
     prefix = summary.read_bytes()
 
@@ -384,9 +385,10 @@ def test_killed_sweep_resumes_without_losing_or_repeating(tmp_path):
     assert set(after["structure"]) == set(enumerate_structures(1, 3))
     assert not after.duplicated(["case", "stage", "structure", "seed"]).any()  # each solve exactly once
     explored = after[after["stage"] == "explore"].groupby("structure").size()
-    # quick's starts by size (`small_problem_starts`): n = joints x 8 waypoints + 3 per link + 6 (39, 28, 17), so
-    # 3 x (39 / 28)^2 = 5.8 starts for two joints and 3 x 4 (the cap) for one
-    assert explored.to_dict() == {s: {1: 12, 2: 6, 3: 3}[len(s)] for s in enumerate_structures(1, 3)}
+    # quick's shares by size (`small_problem_starts`): n = joints x 8 waypoints + 3 per link + 6 (39, 28, 17), so
+    # 3 x (39 / 28)^2 = 5.8 starts for two joints and 3 x 4 (the cap) for one; every arm here small, so twice its
+    # share (`small_arm_starts`)
+    assert explored.to_dict() == {s: {1: 24, 2: 12, 3: 6}[len(s)] for s in enumerate_structures(1, 3)}
     assert summary.read_bytes().startswith(prefix)  # finished rows untouched, byte for byte
     for f, digest in kept.items():
         assert _digest(out / "structures" / "k" / f) == digest

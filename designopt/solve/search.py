@@ -203,6 +203,10 @@ class Search:
     small_arm_screens_once: bool = False
     #: Small arms' ``perturbation`` (None: ``perturbation``; `perturbation_for`).
     small_arm_perturbation: float | None = None
+    #: Small arms' exploration starts times this, after ``small_problem_starts``' share (`starts_for`); their screen
+    #: as that share gives it. A small arm's best family can be the coarse optimum of about one start in a hundred,
+    #: and when reached rank first on the coarse path.
+    small_arm_starts: float = 1.0
     #: A problem with fewer unknowns than the largest gets as many exploration starts as cost about what the
     #: largest one's ``starts`` cost, at most this many times ``starts`` (`exploration_starts`), and screens as many
     #: times more candidates on as many more waypoints as keep its screen the largest one's size (`screening`;
@@ -263,7 +267,7 @@ class Search:
     def most_starts(self) -> int:
         """The most exploration starts one problem gets (`exploration_starts`): the second round's start indices
         follow them."""
-        return math.ceil(self.starts * max(self.small_problem_starts, 1.0))
+        return math.ceil(self.starts * max(self.small_problem_starts, 1.0) * max(self.small_arm_starts, 1.0))
 
     @property
     def leaders(self) -> int:
@@ -351,6 +355,12 @@ class Search:
             return self.small_arm_perturbation
         return self.perturbation
 
+    def starts_for(self, moving_joints: int, share: int) -> int:
+        """The exploration starts of an arm of ``moving_joints`` moving joints whose share of the batch is ``share``
+        (`strategies.coarse_to_fine.exploration_starts`): ``small_arm_starts`` times it for a small arm
+        (`small_arm`), else the share."""
+        return round(share * self.small_arm_starts) if small_arm(moving_joints) else share
+
     def passes_for(self, moving_joints: int) -> list[tuple[float | None, str | None]]:
         """The screen's passes for an arm of ``moving_joints`` moving joints: every one of `screen_passes`, or only
         the first for a small arm (`small_arm`) when ``small_arm_screens_once``."""
@@ -372,6 +382,8 @@ class Search:
                  "mixed": " (every other one drawn from the task's box)"}[self.spread]
         if self.small_arm_perturbation is not None:
             drawn += f" (an arm of fewer than {SMALL_ARM} joints perturbed by {self.small_arm_perturbation:g})"
+        if self.small_arm_starts != 1.0:
+            drawn += f" ({self.small_arm_starts:g}x as many for an arm of fewer than {SMALL_ARM} joints)"
         if self.init == "home":
             drawn += " (their IK walks pulled towards the first waypoint's configuration)"
         which = ("the best" if self.reflect_within is None else
@@ -501,12 +513,13 @@ PRESETS: dict[str, Search] = {
     # structures have fewer than six joints or prismatic ones); the exploration and the screen (20 waypoints) by the
     # LDLᵀ, each candidate screened a second time by MUMPS where the arm has 5 or more joints and ranked by its
     # better pass; the best 4 refined; each structure's best reflected across its length bounds. An arm of fewer
-    # joints gets more starts and screens (`small_problem_starts`, `screening`), perturbed by 0.6 below 5 joints.
-    # Each setting was judged on fresh sweep seeds against the preset before it: docs/benchmarks.md "Sweep",
-    # docs/decisions.md.
+    # joints gets more starts and screens (`small_problem_starts`, `screening`); below 5 joints perturbed by 0.6 and
+    # twice its share of the starts (`small_arm_starts`). Each setting was judged on fresh seeds against the preset
+    # before it (whole sweeps; the small arms' doubled starts on 20 seeds of each small reference structure searched
+    # alone): docs/benchmarks.md "Sweep", docs/decisions.md.
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
                     explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), small_arm_screens_once=True,
-                    small_arm_perturbation=0.6,
+                    small_arm_perturbation=0.6, small_arm_starts=2,
                     profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
     "default": DEFAULT,
     # a best design worth three times the wait: the default made three times independently, the best of the three

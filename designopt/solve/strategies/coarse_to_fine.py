@@ -64,13 +64,21 @@ def coarse_problem(problem: DesignProblem, waypoints: int) -> DesignProblem:
 
 
 def exploration_starts(problems: list[DesignProblem], search) -> list[int]:
-    """Exploration starts per problem: ``search.starts`` each; with ``search.small_problem_starts`` above 1, a
-    problem with fewer unknowns n than the largest of ``problems`` gets starts x (n_max / n)^2, rounded, at most
-    ``small_problem_starts`` x starts. n counts the exploration problem's joints (moving joints x
-    ``explore_waypoints``) and design joints. A start's CPU grows about as n^2 (iterations and their cost both grow
-    with n; a K = I sweep: 0.038, 0.069, 0.097, 0.144 s per start of its 3-, 4-, 5- and 6-joint structures, where
-    (n_max / n)^2 predicts 3.5, 2.1, 1.4 and 1 times the last), so each problem's exploration costs about the largest
-    one's: a small structure, whose starts are cheap and whose basins its `starts` miss, gets more of them."""
+    """Exploration starts per problem: its share of the batch (`shares`), ``search.small_arm_starts`` times it for a
+    small arm (`Search.starts_for`)."""
+    return [search.starts_for(p.chain.n_moving, share) for p, share in zip(problems, shares(problems, search),
+                                                                           strict=True)]
+
+
+def shares(problems: list[DesignProblem], search) -> list[int]:
+    """Each problem's share of a batch's exploration starts: ``search.starts`` each; with
+    ``search.small_problem_starts`` above 1, a problem with fewer unknowns n than the largest of ``problems`` gets
+    starts x (n_max / n)^2, rounded, at most ``small_problem_starts`` x starts. n counts the exploration problem's
+    joints (moving joints x ``explore_waypoints``) and design joints. A start's CPU grows about as n^2 (iterations
+    and their cost both grow with n; a K = I sweep: 0.038, 0.069, 0.097, 0.144 s per start of its 3-, 4-, 5- and
+    6-joint structures, where (n_max / n)^2 predicts 3.5, 2.1, 1.4 and 1 times the last), so each problem's
+    exploration costs about the largest one's: a small structure, whose starts are cheap and whose basins its
+    `starts` miss, gets more of them."""
     if search.small_problem_starts <= 1:
         return [search.starts] * len(problems)
     size = _unknowns(problems, search.explore_waypoints)
@@ -80,7 +88,7 @@ def exploration_starts(problems: list[DesignProblem], search) -> list[int]:
 
 def screening(problems: list[DesignProblem], search) -> list[tuple[int, int | None]]:
     """(candidates, waypoints) of each problem's screen: ``search.screen`` on ``search.screen_waypoints`` each; with
-    ``search.small_problem_starts`` above 1, a problem explored with more starts (`exploration_starts`) screens as
+    ``search.small_problem_starts`` above 1, a problem with a larger share of the starts (`shares`) screens as
     many times more candidates, on as many waypoints w as keep its screen problem the size of the largest one's
     (m w + d = n_max for m moving and d design joints; at least ``screen_waypoints``; None, the full path, once w
     reaches the path's count). A small structure's optima often tie on a coarse sampling and part only on the full
@@ -90,7 +98,7 @@ def screening(problems: list[DesignProblem], search) -> list[tuple[int, int | No
         return [(search.screen, search.screen_waypoints)] * len(problems)
     largest = max(_unknowns(problems, search.screen_waypoints), default=1)
     out = []
-    for problem, starts in zip(problems, exploration_starts(problems, search), strict=True):
+    for problem, starts in zip(problems, shares(problems, search), strict=True):
         chain = problem.chain
         waypoints = max(search.screen_waypoints, round((largest - chain.n_design) / max(chain.n_moving, 1)))
         full = waypoints >= problem.toolpath.n
