@@ -16,7 +16,10 @@ config's, keeping the config's solver profile (the sweep's caps and IPOPT option
 ``python -m designopt.verify`` re-checks it). A structure of 4-6 joints takes 4-20 s of CPU per run. Alone, a
 structure gets the preset's ``starts`` and ``screen``; in a sweep a smaller one gets more (`small_problem_starts`),
 so to search it as a sweep does, set them (a 5-joint structure in the K = I sweep: ``starts=56,screen=17,
-screen_waypoints=25,small_problem_starts=1``; 4 joints 84, 25, 32; 3 joints 139, 42, 40).
+screen_waypoints=25,small_problem_starts=1``; 4 joints 84, 25, 32; 3 joints 139, 42, 40, where alone a screen on
+all of a 40-waypoint path's waypoints is skipped while the sweep screens on the full path). Since `quick` gives an
+arm of fewer than 5 joints twice its share (`Search.small_arm_starts`), such an arm's sweep starts are 168 (4 joints)
+and 278 (3 joints), its screen as before.
 """
 
 from __future__ import annotations
