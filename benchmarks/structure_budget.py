@@ -19,7 +19,8 @@ so to search it as a sweep does, set them (a 5-joint structure in the K = I swee
 screen_waypoints=25,small_problem_starts=1``; 4 joints 84, 25, 32; 3 joints 139, 42, 40, where alone a screen on
 all of a 40-waypoint path's waypoints is skipped while the sweep screens on the full path). Since `quick` gives an
 arm of fewer than 5 joints twice its share (`Search.small_arm_starts`), such an arm's sweep starts are 168 (4 joints)
-and 278 (3 joints), its screen as before.
+and 278 (3 joints), its screen as before: with ``starts`` set to its share (84, 139) the config's `quick` doubles it
+as the sweep does, and ``small_arm_starts=1`` searches it with the share alone.
 """
 
 from __future__ import annotations
