@@ -950,8 +950,8 @@ def test_a_small_arm_gets_more_exploration_starts_but_the_screen_of_its_share():
                              for s in ("RRR", "RRRR", "RRRRR", "RRRRRR"))
     base = Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, small_problem_starts=4)
     more = replace(base, small_arm_starts=2)
-    assert shares([rrr, rrrr, rrrrr, six], more) == exploration_starts([rrr, rrrr, rrrrr, six], base) == [139, 84, 56,
-                                                                                                         40]
+    arms = [rrr, rrrr, rrrrr, six]
+    assert shares(arms, more) == exploration_starts(arms, base) == [139, 84, 56, 40]
     assert exploration_starts([rrr, rrrr, rrrrr, six], more) == [278, 168, 56, 40]
     assert screening([rrr, rrrr, rrrrr, six], more) == screening([rrr, rrrr, rrrrr, six], base)
     assert exploration_starts([rrrr], replace(more, small_problem_starts=1)) == [80]

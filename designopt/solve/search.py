@@ -205,10 +205,10 @@ class Search:
     small_arm_perturbation: float | None = None
     #: Small arms' exploration starts times this, after ``small_problem_starts``' share (`starts_for`); their screen
     #: as that share gives it. A small arm's best family can be the coarse optimum of about one start in a hundred,
-    #: and when reached rank first on the coarse path.
+    #: and when reached ranks first on the coarse path.
     small_arm_starts: float = 1.0
     #: A problem with fewer unknowns than the largest gets as many exploration starts as cost about what the
-    #: largest one's ``starts`` cost, at most this many times ``starts`` (`exploration_starts`), and screens as many
+    #: largest one's ``starts`` cost, at most this many times ``starts`` (its share, `shares`), and screens as many
     #: times more candidates on as many more waypoints as keep its screen the largest one's size (`screening`;
     #: both in `strategies.coarse_to_fine`); 1: every problem ``starts``, ``screen`` and ``screen_waypoints``.
     small_problem_starts: float = 1.0

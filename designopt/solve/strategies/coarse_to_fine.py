@@ -66,8 +66,8 @@ def coarse_problem(problem: DesignProblem, waypoints: int) -> DesignProblem:
 def exploration_starts(problems: list[DesignProblem], search) -> list[int]:
     """Exploration starts per problem: its share of the batch (`shares`), ``search.small_arm_starts`` times it for a
     small arm (`Search.starts_for`)."""
-    return [search.starts_for(p.chain.n_moving, share) for p, share in zip(problems, shares(problems, search),
-                                                                           strict=True)]
+    counts = shares(problems, search)
+    return [search.starts_for(p.chain.n_moving, share) for p, share in zip(problems, counts, strict=True)]
 
 
 def shares(problems: list[DesignProblem], search) -> list[int]:
