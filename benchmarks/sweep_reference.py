@@ -6,10 +6,13 @@ sweep's best (its table.csv) to that reference. A ratio below 1 means the sweep 
 
     .venv/bin/python benchmarks/sweep_reference.py results/structures/<run> RRR RPR RRRR ... [--starts 240]
     .venv/bin/python benchmarks/sweep_reference.py results/structures/<run> --references FILE.csv
+    .venv/bin/python benchmarks/sweep_reference.py results/structures/<run> RRPRRR --seed 100 --keep DIR
 
 ``--save FILE.csv`` keeps the large-budget costs (structure, reference_cost, seconds); ``--references FILE.csv``
 compares a sweep with kept ones instead of searching again (the structures: the file's), keeping per structure
-the lower of a kept reference and the sweep's own best when ``--save`` names the same file.
+the lower of a kept reference and the sweep's own best when ``--save`` names the same file. ``--keep DIR`` writes
+each large-budget run's directory (its solution files, `python -m designopt.verify` re-checks them) under DIR
+instead of a temporary directory.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ import argparse
 import signal
 import tempfile
 import time
+from contextlib import nullcontext
 from dataclasses import replace
 from pathlib import Path
 
@@ -38,6 +42,7 @@ def main() -> None:
     parser.add_argument("--starts", type=int, default=240)
     parser.add_argument("--refine", type=int, default=8)
     parser.add_argument("--seed", type=int, default=100)
+    parser.add_argument("--keep", type=Path, help="write each large-budget run's directory here (default: dropped)")
     args = parser.parse_args()
     sweep = Path(args.sweep)
     table = pd.read_csv(sweep / "table.csv").set_index("structure")
@@ -48,7 +53,7 @@ def main() -> None:
     if not structures:
         parser.error("name the structures, or --references")
     ratios, rows = [], []
-    with tempfile.TemporaryDirectory() as tmp:
+    with nullcontext(args.keep) if args.keep else tempfile.TemporaryDirectory() as tmp:
         for structure in structures:
             t0 = time.perf_counter()
             if kept is not None:
