@@ -952,8 +952,8 @@ def test_a_small_arm_gets_more_exploration_starts_but_the_screen_of_its_share():
     more = replace(base, small_arm_starts=2)
     arms = [rrr, rrrr, rrrrr, six]
     assert shares(arms, more) == exploration_starts(arms, base) == [139, 84, 56, 40]
-    assert exploration_starts([rrr, rrrr, rrrrr, six], more) == [278, 168, 56, 40]
-    assert screening([rrr, rrrr, rrrrr, six], more) == screening([rrr, rrrr, rrrrr, six], base)
+    assert exploration_starts(arms, more) == [278, 168, 56, 40]
+    assert screening(arms, more) == screening(arms, base)
     assert exploration_starts([rrrr], replace(more, small_problem_starts=1)) == [80]
     assert exploration_starts([six], more) == [40]
     assert more.most_starts == 320 and base.most_starts == 160
