@@ -17,7 +17,7 @@ from designopt.initial_guess import initial_guesses
 from designopt.problem import problem_from_config
 from designopt.solve import SolverProfile
 from designopt.solve.local import prepared
-from designopt.transcriptions import Collocation
+from designopt.transcriptions import Collocation, InitialGuess
 from designopt.transcriptions.compiled import AUTO_O1_FROM, compiled, level
 from designopt.transcriptions.forward_kinematics import ForwardKinematics
 from designopt.transcriptions.nlp import split_terms
@@ -60,6 +60,25 @@ def test_gantry_known_optimum():
     assert np.all(sol.raw.q_d >= 0) and np.all(sol.raw.q_d < 3e-3)
     # Line along x_W maps to base z under pitch -pi/2: only d1 moves, by the line's length.
     assert np.ptp(sol.raw.Q[:, 0]) == pytest.approx(0.2, abs=1e-6)
+
+
+def test_violation_is_zero_at_a_solution_and_a_bound_overstepped_by_what_it_oversteps():
+    """`NLP.violation` at the gantry's optimum (what IPOPT calls feasible: within its tolerances), then with one
+    knot velocity of the decision vector 0.3 beyond its limit: the velocity's own bound is the worst (its
+    neighbouring midpoint velocities move by a quarter of the change, the tracking rows not at all), so the
+    violation is that 0.3."""
+    problem = replace(problem_from_config(parse_config(gantry_config())), smoothness=0.0, joint_regularization=0.0)
+    sol = solve_from(problem, initial_guesses(problem, 1, seed=0, scale=0.3, mode="constant")[0])
+    built = Collocation().build(problem)
+    Q, V = np.array(sol.raw.Q), np.array(sol.raw.V)
+    assert built.nlp.violation(built.pack(InitialGuess(q_d=sol.raw.q_d, Q=Q, V=V))) < 1e-8
+    v_max = problem.velocity_limits[0]
+    assert np.abs(V[:, 0]).max() < 0.5 * v_max  # the premise: the midpoints stay within their limits
+    x = built.pack(InitialGuess(q_d=sol.raw.q_d, Q=Q, V=V))
+    at = built.nlp.n_design + 5 * built.n_state + problem.chain.n_moving  # knot 5's first velocity
+    assert x[at] == V[5, 0]
+    x[at] = v_max + 0.3  # (pack itself clips velocities to their limits)
+    assert built.nlp.violation(x) == pytest.approx(0.3, abs=1e-8)
 
 
 @pytest.mark.parametrize("tracking", ["hard", "soft"])

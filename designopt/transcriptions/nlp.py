@@ -156,6 +156,15 @@ class NLP:
         in no block, `ConstraintList.rows`)."""
         return self.constraints.stacked()[0]
 
+    def violation(self, x: np.ndarray) -> float:
+        """The largest amount by which the decision vector ``x`` lies outside its bounds or a constraint row outside
+        its bounds (in the row's own units: m, rad, rad/s; 0 for a feasible point). The NLP's ``g`` is built for
+        it if it has not been."""
+        x = np.asarray(x, float)
+        g = np.asarray(ca.Function("g", [self.x], [self.g])(x), float).ravel()
+        over = [self.lbx - x, x - self.ubx, self.lbg - g, g - self.ubg]
+        return float(max(0.0, *(np.max(v, initial=0.0) for v in over)))
+
     @staticmethod
     def _level(block: BlockStructure, compile_mode: str) -> str:
         """The compile mode of a block's functions under the profile's ``compile_mode`` (`compiled.level`)."""
