@@ -156,50 +156,34 @@ def projected(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, iterations
     """``Q`` (N x n_moving) moved onto the path with the design ``q_d`` held: at every waypoint a damped
     least-squares IK on the tracking residual (tool position in W [m], tool axis), within the joints' bounds,
     from that waypoint's row of ``Q`` (so that it keeps its branch). Then, from the first waypoint on, a
-    waypoint whose row of ``Q`` was not on its target already (within ``tol``: a lifted solution's own knots are
-    kept) and is still further than ``tol`` from it, or one further from the waypoint before it than a
-    trajectory within the velocity limits moves between any two of its times (`beyond_reach` with `OVERSHOOT`:
-    the IK or ``Q`` changed branch there; a solution of another sampling, sampled here, moves up to that far
-    within its limits), starts again from the waypoint before it (moved as ``Q`` moves there, where that move is
-    within reach), as a walk along the path does. The walk is kept if it is nearer the target, or
+    waypoint still further than ``tol`` from its target, or one that no trajectory within the velocity limits
+    reaches from the waypoint before it (`beyond_reach`: the IK or ``Q`` changed branch there), starts again
+    from the waypoint before it, as a walk along the path does. The walk is kept if it is nearer the target, or
     if it is on it (within ``tol``) and within reach where the step was not (where the path itself asks for more
     than the limits allow, the IK's own answer stays). A waypoint's residual never grows above its row's, or
     above ``tol`` where the step was beyond reach."""
-    given = np.array(Q, dtype=float)
-    everywhere = np.arange(len(given))
+    Q = np.array(Q, dtype=float)
+    everywhere = np.arange(len(Q))
     chain = pickle.dumps(problem.chain)
-    lo, hi = moving_bounds(problem)
-    on_path = np.linalg.norm(_moved_onto_path(problem, q_d, given, everywhere, 0, chain)[1], axis=1) <= tol
-    Q, r = _moved_onto_path(problem, q_d, given.copy(), everywhere, iterations, chain)
+    Q, r = _moved_onto_path(problem, q_d, Q, everywhere, iterations, chain)
     for k in range(1, len(Q)):
-        jumped = bool(beyond_reach(problem, Q[k - 1 : k + 1], k - 1, OVERSHOOT)[0])
-        if not on_path[k] and (np.linalg.norm(r[k]) > tol or jumped):
-            # from k - 1 moved as ``Q`` moves to k, unless that move is itself a change of branch
-            moved = not beyond_reach(problem, given[k - 1 : k + 1], k - 1, OVERSHOOT)[0]
-            ahead = np.clip(Q[k - 1] + (given[k] - given[k - 1] if moved else 0.0), lo, hi)[None, :]
-            walked, r_walked = _moved_onto_path(problem, q_d, ahead, everywhere[k : k + 1], iterations, chain)
+        jumped = bool(beyond_reach(problem, Q[k - 1 : k + 1], k - 1)[0])
+        if np.linalg.norm(r[k]) > tol or jumped:
+            walked, r_walked = _moved_onto_path(problem, q_d, Q[k - 1 : k], everywhere[k : k + 1], iterations,
+                                                chain)
             nearer = r_walked[0] @ r_walked[0] < r[k] @ r[k]
             reached = np.linalg.norm(r_walked[0]) <= tol and not beyond_reach(problem, np.vstack([Q[k - 1], walked]),
-                                                                             k - 1, OVERSHOOT)[0]
+                                                                             k - 1)[0]
             if nearer or (jumped and reached):
                 Q[k], r[k] = walked[0], r_walked[0]
     return Q
 
 
-# The most a trajectory the collocation accepts moves between two of its times, over v_max times the time between
-# them: its cubic's velocity is a quadratic in each interval, bounded by v_max at the knots and the midpoint, and a
-# quadratic through three such values stays within 1.25 v_max (the Lebesgue constant of three equispaced nodes).
-# A solution of a coarser sampling sampled at this problem's waypoints (a lifted start) moves up to 1.25 v_max h
-# between them; a step beyond that is a change of branch, not the cubic's overshoot.
-OVERSHOOT = 1.25
-
-
-def beyond_reach(problem: DesignProblem, Q: np.ndarray, first: int = 0, slack: float = 1.0) -> np.ndarray:
+def beyond_reach(problem: DesignProblem, Q: np.ndarray, first: int = 0) -> np.ndarray:
     """For each step between rows of ``Q`` (waypoints ``first``, ``first + 1``, ...): is some joint's step
-    longer than ``slack`` times what it can move in the time between them (`DesignProblem.max_steps`)? With
-    ``slack`` 1 no trajectory the collocation accepts makes such a step between its waypoints; with `OVERSHOOT`
-    none between any two of its times. (len(Q) - 1 booleans.)"""
-    return np.any(np.abs(np.diff(Q, axis=0)) > slack * problem.max_steps[first : first + len(Q) - 1], axis=1)
+    longer than it can move in the time between them (`DesignProblem.max_steps`)? No trajectory the collocation
+    accepts makes such a step. (len(Q) - 1 booleans.)"""
+    return np.any(np.abs(np.diff(Q, axis=0)) > problem.max_steps[first : first + len(Q) - 1], axis=1)
 
 
 def _moved_onto_path(problem: DesignProblem, q_d: np.ndarray, Q: np.ndarray, ks: np.ndarray, iterations: int,

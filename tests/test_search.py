@@ -21,7 +21,6 @@ from designopt.costs import tracking_residual
 from designopt.experiments.adapters import search_from_config, structure_config
 from designopt.experiments.run import draw_bests
 from designopt.initial_guess import (
-    OVERSHOOT,
     _moved_onto_path,
     beyond_reach,
     first_configuration,
@@ -181,53 +180,6 @@ def test_a_lifted_solution_starts_where_it_ended(milling_12_slow):
     assert np.allclose(guess.Q[shared], sol.raw.Q, atol=1e-12)
     assert np.allclose(guess.V[shared], sol.raw.V, atol=1e-9)
     assert np.array_equal(guess.q_d, sol.raw.q_d)
-
-
-def test_a_lifted_solution_keeps_its_knots_at_its_velocity_limits(milling_12):
-    """The main job's coarse optimum moves a joint at its velocity limit (the premise); lifted to the full path,
-    the start still passes through the coarse solution at the times both paths share: those waypoints are on the
-    path as given and are not walked again, although the cubic sampled between them moves further than v_max h
-    between two waypoints (up to `OVERSHOOT` times that)."""
-    full = problem_from_config(parse_config(milling_12))
-    coarse = coarse_problem(full, 6)
-    sol = solve(coarse, max_iter=300)
-    assert sol.metrics.tracks and np.abs(sol.raw.V).max() > 0.999 * full.velocity_limits.max()
-    sampled = sol.sample(full.toolpath.t)
-    assert beyond_reach(full, sampled).any()  # the premise: steps beyond v_max h that are no change of branch
-    assert not beyond_reach(full, sampled, slack=OVERSHOOT).any()
-    guess = lifted_guess(full, sol)
-    shared = np.flatnonzero(np.isin(full.toolpath.t, coarse.toolpath.t))
-    assert np.array_equal(guess.Q[shared], sol.raw.Q)
-
-
-@settings(max_examples=60, deadline=None)
-@given(st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3), st.floats(0.01, 1.0),
-       st.lists(st.floats(0.0, 1.0), min_size=2, max_size=2))
-@example([1.0, 1.0, -1.0], 0.1, [0.25, 0.25 + 1e-6])
-def test_a_cubic_within_its_velocity_limits_moves_at_most_overshoot_times_them(velocities, h, times):
-    """`OVERSHOOT` against the cubic itself: a Hermite cubic over [0, h] whose velocities at both knots and at the
-    midpoint are within +-1 (what the collocation bounds), built from them in numpy, moves between any two of its
-    times at most 1.25 times their distance; with velocities 1, 1, -1 (knot, midpoint, knot) it moves at 1.25 at a
-    quarter of the interval, so no smaller slack holds."""
-    v0, vm, v1 = velocities
-    dq = (vm + (v0 + v1) / 4) * 2 * h / 3  # the collocation's midpoint velocity: 3/2 dq/h - (v0 + v1)/4
-
-    def q(t):  # the cubic through (0, 0, v0) and (h, dq, v1), Hermite basis
-        s = t / h
-        return (-2 * s**3 + 3 * s**2) * dq + (s**3 - 2 * s**2 + s) * h * v0 + (s**3 - s**2) * h * v1
-
-    def velocity(t):  # its derivative in closed form
-        s = t / h
-        return (-6 * s**2 + 6 * s) * dq / h + (3 * s**2 - 4 * s + 1) * v0 + (3 * s**2 - 2 * s) * v1
-
-    assert velocity(0.0) == pytest.approx(v0) and velocity(h) == pytest.approx(v1)
-    assert velocity(h / 2) == pytest.approx(vm, abs=1e-12)  # the premise: the midpoint's velocity is vm
-    a, b = sorted(t * h for t in times)
-    if b > a:
-        assert abs(q(b) - q(a)) <= OVERSHOOT * (b - a) * (1 + 1e-9)
-    if (v0, vm, v1) == (1.0, 1.0, -1.0):
-        assert velocity(h / 4) == pytest.approx(OVERSHOOT)
-        assert (q(b) - q(a)) / (b - a) == pytest.approx(OVERSHOOT, rel=1e-4)
 
 
 def test_a_lifted_start_is_on_the_path_between_the_coarse_knots(milling_12):
