@@ -278,6 +278,9 @@ MUTATIONS = [
              "kept = best_solution([sol for _, sol in passes[seed]])",
              "kept = max((s for _, s in passes[seed] if s.metrics.tracks), key=lambda s: s.metrics.design_cost, "
              "default=None)", ("tests/test_search.py",)),
+    Mutation("a decision vector's own bounds left out of its violation", "designopt/transcriptions/nlp.py",
+             "over = [self.lbx - x, x - self.ubx, self.lbg - g, g - self.ubg]", "over = [self.lbg - g, g - self.ubg]",
+             ("tests/test_collocation.py", "tests/test_cli_and_files.py")),
     Mutation("lifted start drops the coarse design", "designopt/solve/starts.py",
              "q_d = np.asarray(solution.raw.q_d, float)", "q_d = problem.chain.design_values"),
     Mutation("a lifted start's waypoints left where the coarse trajectory puts them", "designopt/solve/starts.py",
