@@ -158,10 +158,10 @@ class NLP:
 
     def violation(self, x: np.ndarray) -> float:
         """The largest amount by which the decision vector ``x`` lies outside its bounds or a constraint row outside
-        its bounds (in the row's own units: m, rad, rad/s; 0 for a feasible point). The NLP's ``g`` is built for
-        it if it has not been."""
+        its bounds (in the row's own units: m, rad, rad/s; 0 for a feasible point). The rows are the solver's own
+        values function (`functions`, interpreted), not a graph built here."""
         x = np.asarray(x, float)
-        g = np.asarray(ca.Function("g", [self.x], [self.g])(x), float).ravel()
+        g = np.asarray(self.functions("none")[1](x), float).ravel()
         over = [self.lbx - x, x - self.ubx, self.lbg - g, g - self.ubg]
         return float(max(0.0, *(np.max(v, initial=0.0) for v in over)))
 
