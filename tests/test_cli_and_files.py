@@ -198,7 +198,8 @@ def test_verify_prints_reported_and_recomputed_and_exits_by_verdict(tmp_path):
 
 def test_every_best_design_known_checks_out():
     """The best designs known per task (benchmarks/reference, what the search is judged against) are re-verified
-    from their files by the independent verifier, and the modular one is a robot of the catalogue's modules."""
+    from their files by the independent verifier, the modular one is a robot of the catalogue's modules, and every
+    structure sweep reference (sweep_structures_<model>.csv) is the cost of a design kept there."""
     from designopt.config import load_config
     from designopt.experiments.modular import catalogue_from_config
     from designopt.verify import verify_file
@@ -222,6 +223,12 @@ def test_every_best_design_known_checks_out():
         for path in backed:
             data = json.loads(path.read_text())
             assert costs[data["structure"]] == pytest.approx(data["metrics"]["design_cost"], rel=1e-12, abs=0), path
+        # and every reference has its design: its own file, or the sweep's lowest design's when it is that structure's
+        lowest = json.loads((reference / f"structures_{model}_best_known.json").read_text())
+        designs = {json.loads(path.read_text())["structure"] for path in backed} | {lowest["structure"]}
+        assert set(costs.index) <= designs, (model, sorted(set(costs.index) - designs))
+        if lowest["structure"] in costs.index:
+            assert costs[lowest["structure"]] == pytest.approx(lowest["metrics"]["design_cost"], rel=1e-12, abs=0)
 
 
 # each best design known's task: the config it was found on (a sweep structure's: the sweep's, with its structure)
