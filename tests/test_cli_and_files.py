@@ -231,6 +231,26 @@ def test_every_best_design_known_checks_out():
             assert costs[lowest["structure"]] == pytest.approx(lowest["metrics"]["design_cost"], rel=1e-12, abs=0)
 
 
+def test_the_reference_readme_lists_every_best_design_known_with_its_cost():
+    """benchmarks/reference/README.md says how each best design known was found: it names every file kept there (and
+    no other), each in a row that states the file's design cost to the six digits it prints."""
+    import re
+
+    reference = Path(__file__).parent.parent / "benchmarks" / "reference"
+    rows = [line for line in (reference / "README.md").read_text().splitlines() if line.startswith("| `")]
+    named = {}
+    for row in rows:
+        files = re.findall(r"`([^`]+_best_known\.json)`", row.split("|")[1])
+        costs = [float(c) for c in row.split("|")[3].split(",")]
+        assert len(files) == len(costs), row
+        named.update(zip(files, costs, strict=True))
+    kept = {p.name for p in reference.glob("*_best_known.json")}
+    assert set(named) == kept, sorted(set(named) ^ kept)
+    for name, cost in named.items():
+        actual = json.loads((reference / name).read_text())["metrics"]["design_cost"]
+        assert float(f"{actual:.5e}") == cost, name
+
+
 # each best design known's task: the config it was found on (a sweep structure's: the sweep's, with its structure)
 REFERENCE_TASKS = {"milling_physical": "physical_stiffness.yaml", "milling": "milling.yaml",
                    "circle_standoff": "circle_standoff.yaml", "structures_k_i": "structures.yaml",
