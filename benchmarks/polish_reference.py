@@ -2,10 +2,11 @@
 
 A solution file is read as a solution of its task's problem (``--config``, with the file's structure when it is a
 sweep structure's), and solved again warm from its own design, joints and velocities, by IPOPT at ``--tol``
-(the library's solves stop at 1e-8, scaled; a design found at that tolerance is a few 1e-4 above the optimum it
-converges to, relatively). Prints the file's design cost and the re-solve's, and with ``--out`` writes the
-re-solved solution when it tracks; whether it replaces a best design known is the caller's decision (its cost is
-what `python -m designopt.verify` checks).
+(the library's solves stop at 1e-8, scaled; a design found at that tolerance is up to about 1e-4 away from the
+design cost of the optimum it converges to, relatively, either way: docs/decisions.md, Search, 2026-12-06).
+Prints the file's design cost and the re-solve's, and with ``--out`` writes the re-solved solution when it tracks;
+whether it replaces a best design known is the caller's decision (its cost is what `python -m designopt.verify`
+checks).
 
     .venv/bin/python benchmarks/polish_reference.py --config configs/structures.yaml \
         benchmarks/reference/structures_k_i_RRPRRR_best_known.json --tol 1e-10
