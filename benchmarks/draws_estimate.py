@@ -18,6 +18,13 @@ is k times a run's (the draws' stages are solved side by side, so their workers 
 
     .venv/bin/python benchmarks/draws_estimate.py DIR/circle_standoff/s* --draws 2 3 \\
         --reference benchmarks/reference/circle_standoff_best_known.json
+
+``--confirm K`` applies a search drawn until K draws reach its answer (a draw's best within ``--within`` of the
+lowest of its seed's draws; at most ``--max-draws``; judged and not adopted, docs/decisions.md, Search,
+2026-12-06) to the runs, seed by seed: RUNS are then
+draws of several seeds (a run of seed s + j x 1,000,000 is draw j of seed s, `Search.draw_seeds`; a run of
+several draws gives them all), and each seed's answer is the lowest of its draws once K reach it (or all
+``--max-draws`` are made). A seed whose next draw is not among RUNS is listed as open, with the seed to run next.
 """
 
 from __future__ import annotations
@@ -32,6 +39,7 @@ import numpy as np
 import pandas as pd
 
 from designopt.experiments.runs import search_of_run
+from designopt.solve.search import DRAW_STRIDE
 from designopt.tables import full_path
 
 WITHIN = 1.10
@@ -75,14 +83,75 @@ def describe(values: np.ndarray, weights: np.ndarray, seeds: int | None = None) 
             f"{support[-1]:.3f}, within {WITHIN:.2f}x {within:.1%}{every}")
 
 
+def reaching(answers: list[float], within: float) -> int:
+    """How many of a seed's draws reach its answer: those within ``within`` times the lowest (inf: a draw that
+    tracks nothing, never one)."""
+    finite = [a for a in answers if np.isfinite(a)]
+    return sum(a <= within * min(finite) for a in finite) if finite else 0
+
+
+def confirmed_answer(answers: list[float], confirm: int, within: float, most: int) -> tuple[float, int] | None:
+    """What a search drawn until ``confirm`` draws reach its answer answers, given its draws' answers in draw order:
+    (the lowest of the draws made, how many were made), or None when the draws given end before it stops. The
+    first ``confirm`` draws are always made; then one more until ``confirm`` reach the lowest (`reaching`) or
+    ``most`` are made."""
+    for made in range(confirm, most + 1):
+        if len(answers) < made:
+            return None
+        if reaching(answers[:made], within) >= confirm or made == most:
+            return min(answers[:made]), made
+    return None
+
+
+def confirm_table(runs: list[Path], known: float, confirm: int, within: float, most: int) -> None:
+    """Prints each seed's draws and the confirmed answer, the distribution over the seeds settled, and the open
+    seeds' next draw to run."""
+    draws: dict[int, dict[int, float]] = {}
+    for run in runs:
+        if not (run / "solution_set.csv").exists():  # written when the search has ended
+            print(f"  {run}: not finished; left out")
+            continue
+        search = search_of_run(run)
+        for k, answer in enumerate(draw_answers(run, known)):
+            seed = search.seed + k * DRAW_STRIDE
+            draws.setdefault(seed % DRAW_STRIDE, {})[seed // DRAW_STRIDE] = answer
+    answers, made, missing = [], [], []
+    for seed in sorted(draws):
+        given = [draws[seed][j] for j in range(len(draws[seed])) if j in draws[seed]]
+        found = confirmed_answer(given, confirm, within, most)
+        shown = ", ".join(f"{a:.3f}" for a in given)
+        if found is None:
+            missing.append(seed + len(given) * DRAW_STRIDE)
+            print(f"  seed {seed}: draws {shown}x; open")
+        else:
+            answers.append(found[0])
+            made.append(found[1])
+            print(f"  seed {seed}: draws {shown}x; answer {found[0]:.3f}x after {found[1]} draws")
+    if answers:
+        a = np.sort(answers)
+        print(f"{len(a)} seeds settled: {describe(a, np.full(len(a), 1 / len(a)))}; within 1.03x "
+              f"{int((a <= 1.03).sum())}; draws made {np.mean(made):.2f} on average, at most {max(made)}")
+    if missing:
+        print(f"open: run seed{'s' if len(missing) > 1 else ''} {' '.join(str(s) for s in missing)} next")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("runs", nargs="+", type=Path)
     parser.add_argument("--reference", required=True, type=Path, help="the best design known (a solution file)")
     parser.add_argument("--draws", nargs="+", type=int, default=[2, 3])
+    parser.add_argument("--confirm", type=int, help="draws until this many reach the answer (RUNS: draws per seed)")
+    parser.add_argument("--within", type=float, default=1.02, help="with --confirm: a draw's best within this of the "
+                                                                     "lowest reaches it")
+    parser.add_argument("--max-draws", type=int, default=5, help="with --confirm: at most this many draws")
     args = parser.parse_args()
     known = json.loads(args.reference.read_text())["metrics"]["design_cost"]
     runs = sorted(args.runs, key=lambda run: int(run.name.lstrip("s")))
+    if args.confirm:
+        print(f"draws until {args.confirm} reach the answer (within {args.within:g}x), at most {args.max_draws}; "
+              "answers / best known")
+        confirm_table(runs, known, args.confirm, args.within, args.max_draws)
+        return
     a = np.array([x for run in runs for x in draw_answers(run, known)])
     n = len(a)
     print(f"{n} draws of {len(runs)} runs, seeds {runs[0].name}-{runs[-1].name}; best / median / p90 / worst of "

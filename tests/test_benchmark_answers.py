@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
-from draws_estimate import draw_answers  # noqa: E402
+from draws_estimate import confirmed_answer, draw_answers  # noqa: E402
 from modular_enumeration import best_per_case  # noqa: E402
 
 from designopt.solve import preset  # noqa: E402
@@ -33,6 +33,17 @@ def test_a_draws_answer_is_its_cheapest_tracking_full_path_solve_never_a_relaxed
     pd.DataFrame(rows, columns=["stage", "seed", "design_cost", "tracks"]).to_csv(tmp_path / "summary.csv",
                                                                                  index=False)
     assert draw_answers(tmp_path, 2.0) == pytest.approx([1.0, float("inf")])
+
+
+def test_a_confirmed_answer_is_the_lowest_draw_once_enough_draws_reach_it():
+    """``--confirm``'s rule (a search drawn until K draws reach its answer): the first K draws always, then until K
+    are within the factor of the lowest or the most are made; None while the draws given end first."""
+    assert confirmed_answer([1.0, 1.015], 2, 1.02, 5) == (1.0, 2)
+    assert confirmed_answer([1.5, 1.2, 1.0, 1.01, 0.1], 2, 1.02, 5) == (1.0, 4)  # the fifth never drawn
+    assert confirmed_answer([1.5, 1.2, 1.0], 2, 1.02, 5) is None
+    assert confirmed_answer([5.0, 4.0, 3.0, 2.0, 1.0], 2, 1.02, 5) == (1.0, 5)
+    assert confirmed_answer([2.0, float("inf"), 2.01], 2, 1.02, 3) == (2.0, 3)
+    assert confirmed_answer([1.0], 2, 1.02, 5) is None
 
 
 def test_an_assignments_full_path_best_leaves_out_its_coarse_and_relaxed_solves():
