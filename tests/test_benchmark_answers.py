@@ -44,6 +44,8 @@ def test_a_confirmed_answer_is_the_lowest_draw_once_enough_draws_reach_it():
     assert confirmed_answer([5.0, 4.0, 3.0, 2.0, 1.0], 2, 1.02, 5) == (1.0, 5)
     assert confirmed_answer([2.0, float("inf"), 2.01], 2, 1.02, 3) == (2.0, 3)
     assert confirmed_answer([1.0], 2, 1.02, 5) is None
+    assert confirmed_answer([1.0, 1.02], 2, 1.02, 5) == (1.0, 2)  # within the factor, its bound included
+    assert confirmed_answer([float("inf"), float("inf")], 2, 1.02, 3) is None  # draws tracking nothing reach nothing
 
 
 def test_an_assignments_full_path_best_leaves_out_its_coarse_and_relaxed_solves():
