@@ -117,7 +117,9 @@ def confirm_table(runs: list[Path], known: float, confirm: int, within: float, m
             draws.setdefault(seed % DRAW_STRIDE, {})[seed // DRAW_STRIDE] = answer
     answers, made, missing = [], [], []
     for seed in sorted(draws):
-        given = [draws[seed][j] for j in range(len(draws[seed])) if j in draws[seed]]
+        given = []  # draws 0, 1, ... as far as none is missing: the rule makes them in that order
+        while len(given) in draws[seed]:
+            given.append(draws[seed][len(given)])
         found = confirmed_answer(given, confirm, within, most)
         shown = ", ".join(f"{a:.3f}" for a in given)
         if found is None:
