@@ -56,3 +56,28 @@ def test_an_assignments_full_path_best_leaves_out_its_coarse_and_relaxed_solves(
                             "design_cost": [0.1, 0.2, 3.0, 2.0, 5.0, 0.05], "tracks": [True] * 6})
     assert best_per_case(summary, "f", full_path=True).to_dict() == {"f12": 2.0, "f34": 5.0}
     assert best_per_case(summary, "f").to_dict() == {"f12": 0.1, "f34": 5.0}
+
+
+def test_the_confirm_table_says_what_the_rule_answers_over_every_draw_given(tmp_path, capsys):
+    """``--confirm`` over runs of one draw each (draw j of seed s the run of seed s + j x 1,000,000): a seed whose
+    first two draws agree stops there, and where a third draw was run anyway (a `thorough` run's) the table says
+    the best of all three and the rule's answer over it; a seed whose draws disagree takes the third."""
+    from draws_estimate import confirm_table
+
+    def run(seed: int, cost: float) -> Path:
+        path = tmp_path / f"s{seed}"
+        path.mkdir()
+        (path / "search.json").write_text(json.dumps(search_to_dict(replace(preset("default"), seed=seed))))
+        (path / "solution_set.csv").write_text("")
+        pd.DataFrame([("refine", seed * 1000, cost, True)], columns=["stage", "seed", "design_cost", "tracks"]).to_csv(
+            path / "summary.csv", index=False)
+        return path
+
+    runs = [run(5 + j * 1_000_000, c) for j, c in enumerate((1.035, 1.035, 1.022))]
+    runs += [run(6 + j * 1_000_000, c) for j, c in enumerate((1.068, 1.094, 1.072))]
+    confirm_table(runs, 1.0, 2, 1.02, 3)
+    out = capsys.readouterr().out
+    assert "seed 5: draws 1.035, 1.035, 1.022x; answer 1.035x after 2 draws; the best of all 3 given 1.022x, " \
+           "the answer 1.0127x it" in out
+    assert "seed 6: draws 1.068, 1.094, 1.072x; answer 1.068x after 3 draws\n" in out
+    assert "2 seeds settled" in out and "draws made 2.50 on average, at most 3" in out
