@@ -111,9 +111,7 @@ def confirm_table(runs: list[Path], known: float, confirm: int, within: float, m
         if not (run / "solution_set.csv").exists():  # written when the search has ended
             print(f"  {run}: not finished; left out")
             continue
-        search = search_of_run(run)
-        for k, answer in enumerate(draw_answers(run, known)):
-            seed = search.seed + k * DRAW_STRIDE
+        for seed, answer in zip(search_of_run(run).draw_seeds, draw_answers(run, known), strict=True):
             draws.setdefault(seed % DRAW_STRIDE, {})[seed // DRAW_STRIDE] = answer
     answers, made, missing = [], [], []
     for seed in sorted(draws):
