@@ -227,6 +227,63 @@ def test_a_hessian_block_found_in_the_cache_is_not_derived_again(tmp_path, monke
     assert len(list(tmp_path.glob("waypoint_hessian_*.so"))) == 2
 
 
+def test_jacobian_gradient_and_split_blocks_found_in_the_cache_are_not_derived_again(tmp_path, monkeypatch):
+    """A block's Jacobian, gradient and split terms are cached under the terms they come from, as its Hessian is:
+    compiled, they equal the interpreted ones, and a build that finds their libraries derives and serialises
+    nothing of them (the Jacobian's rows and columns come from the terms' own sparsity)."""
+    from designopt.transcriptions import hessian as hessian_module
+    from designopt.transcriptions.jacobian import block_gradient_function, block_jacobian_function
+    from designopt.transcriptions.nlp import compiled_split_terms
+
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    y, s_W = ca.SX.sym("y", 3), ca.SX.sym("s_W", 2)
+    terms = ca.Function("terms", [y, s_W], [ca.sin(y[0]) * ca.sumsqr(y[1:]),
+                                            ca.vertcat(y[1] * y[2] - s_W[0], ca.cos(y[0]) * s_W[1], y[2])])
+    args = [np.array([0.3, -1.2, 0.8]), np.array([0.5, 2.0])]
+
+    def built():
+        jac, rows, cols = block_jacobian_function(terms, "O0")
+        return jac, rows, cols, block_gradient_function(terms, "O0"), compiled_split_terms(terms, "O0")
+
+    jac, rows, cols, grad, (phi, c) = built()
+    J = np.zeros((3, 3))
+    J[rows, cols] = np.array(jac(*args)).ravel()
+    x0, x1, x2 = args[0]
+    np.testing.assert_allclose(J, [[0, x2, x1], [-np.sin(x0) * 2.0, 0, 0], [0, 0, 1]], rtol=1e-13)
+    np.testing.assert_allclose(np.array(grad(*args)).ravel(),
+                               [np.cos(x0) * (x1**2 + x2**2), 2 * x1 * np.sin(x0), 2 * x2 * np.sin(x0)], rtol=1e-13)
+    assert float(phi(*args)) == pytest.approx(np.sin(x0) * (x1**2 + x2**2), rel=1e-13)
+    np.testing.assert_allclose(np.array(c(*args)).ravel(), [x1 * x2 - 0.5, np.cos(x0) * 2.0, x2], rtol=1e-13)
+    libraries = sorted(tmp_path.glob("*.so"))
+    assert len(libraries) == 4
+    for name in ("jacobian", "gradient"):
+        monkeypatch.setattr(ca, name, lambda *a, name=name: pytest.fail(f"{name} derived although cached"))
+    monkeypatch.setattr(hessian_module, "_serialised", lambda f: f.serialize())  # no memo: count each serialisation
+    serialised, serialize = [], ca.Function.serialize
+    monkeypatch.setattr(ca.Function, "serialize", lambda f, *a: serialised.append(f.name()) or serialize(f, *a))
+    assert built()[0].class_name() == "External"
+    assert serialised == ["terms"] * 4 and sorted(tmp_path.glob("*.so")) == libraries
+
+
+def test_a_gradient_with_entries_no_term_touches_is_dense_and_ipopt_reads_it_right():
+    """nlpsol hands IPOPT the nonzeros of the grad_f it is given as the whole gradient: a gradient output without
+    stored entries for the variables no objective term touches (the points only a clearance block covers) would
+    move every later entry. The assembled gradient is dense, and IPOPT finds the known optimum of
+    min (x0 - 1)^2 + (x2 - 2)^2 subject to x1 = x0 + x2: (1, 3, 2)."""
+    from designopt.transcriptions.jacobian import assemble_gradient
+
+    y, target = ca.SX.sym("y"), ca.SX.sym("t")
+    block = ca.Function("block_gradient", [y, target], [2 * (y - target)])
+    grad_f = assemble_gradient(3, None, [(block, np.array([[0], [2]]), [ca.DM([[1.0, 2.0]])])])
+    assert grad_f.sparsity_out(1).is_dense()
+    x = ca.MX.sym("x", 3)
+    problem = {"x": x, "f": (x[0] - 1) ** 2 + (x[2] - 2) ** 2, "g": x[1] - x[0] - x[2]}
+    ipopt = ca.nlpsol("ipopt", "ipopt", problem, {"grad_f": grad_f, "ipopt.print_level": 0, "print_time": False})
+    out = ipopt(x0=[5.0, 5.0, 5.0], lbg=0, ubg=0)
+    assert ipopt.stats()["success"]
+    np.testing.assert_allclose(np.array(out["x"]).ravel(), [1.0, 3.0, 2.0], atol=1e-8)
+
+
 def test_ik_start_tracks_a_reachable_path():
     cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 20},
            "placement": {"xyz": [0.45, 0.0, -0.2]}}

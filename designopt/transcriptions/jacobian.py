@@ -19,20 +19,29 @@ from collections.abc import Callable
 import casadi as ca
 import numpy as np
 
-from designopt.transcriptions.compiled import compiled
-from designopt.transcriptions.hessian import block_symbols, ccs_sparsity, per_point
+from designopt.transcriptions.compiled import compiled_as
+from designopt.transcriptions.hessian import block_symbols, ccs_sparsity, derivation_identity, per_point
 
 
 def block_jacobian_function(terms: ca.Function, compile_mode: str,
                             used: list | None = None) -> tuple[ca.Function, np.ndarray, np.ndarray]:
     """(function (y, *inputs) -> the structural nonzeros of dc/dy as one column, their rows in c, their columns
-    in y). ``terms`` is a block's (y, *inputs) -> (phi, c); ``used``: `compiled.compiled_as`."""
-    y, params = block_symbols(terms)
-    _, c = terms(y, *params)
-    J = ca.jacobian(c, y)
-    rows, cols = J.sparsity().get_triplet()
-    fn = ca.Function("block_jacobian", [y, *params], [ca.vertcat(*J.nonzeros()) if J.nnz() else ca.SX(0, 1)])
-    return compiled(fn, compile_mode, used), np.asarray(rows, int), np.asarray(cols, int)
+    in y). ``terms`` is a block's (y, *inputs) -> (phi, c); ``used``: `compiled.compiled_as`. Compiled, the function
+    is found in the cache by ``terms`` and this derivation, so that a warm build derives nothing; its nonzeros'
+    pattern is ``terms``' own Jacobian sparsity of c in y (checked whenever it is derived)."""
+    pattern = terms.jac_sparsity(1, 0)
+
+    def derive() -> ca.Function:
+        y, params = block_symbols(terms)
+        _, c = terms(y, *params)
+        J = ca.jacobian(c, y)
+        if J.sparsity() != pattern:
+            raise AssertionError(f"the Jacobian of {terms.name()}'s c has other nonzeros than its sparsity says")
+        return ca.Function("block_jacobian", [y, *params], [ca.vertcat(*J.nonzeros()) if J.nnz() else ca.SX(0, 1)])
+
+    rows, cols = pattern.get_triplet()
+    fn = compiled_as("block_jacobian", derivation_identity(terms, block_jacobian_function), derive, compile_mode, used)
+    return fn, np.asarray(rows, int), np.asarray(cols, int)
 
 
 def unclaimed_rows(n_g: int, mu_indices: list[np.ndarray]) -> np.ndarray:
@@ -79,7 +88,9 @@ def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: 
     values = []
     for block, _, _, y_index, block_inputs, _ in groups:
         values.append(ca.vec(block.map(y_index.shape[0])(per_point(X, y_index), *block_inputs)))
-    rest_fn = ca.Function("jac_rest", [x], [ca.vertcat(*J_rest.nonzeros()) if J_rest.nnz() else ca.SX(0, 1)])
+    # its nonzeros as one column by slicing (`nz[:]`): vertcat of the Python list of SX scalars was a fifth of a
+    # 1,208-waypoint program's warm build
+    rest_fn = ca.Function("jac_rest", [x], [J_rest.nz[:] if J_rest.nnz() else ca.SX(0, 1)])
     values.append(rest_fn(X))
     nz = ca.vertcat(*values)[ca.DM(order.tolist())]
     g = not_computed(n_g) if g_of is None else g_of(X)
@@ -98,13 +109,18 @@ def not_computed(n: int) -> ca.MX:
 
 def block_gradient_function(terms: ca.Function, compile_mode: str, used: list | None = None) -> ca.Function | None:
     """(y, *inputs) -> dphi/dy as a dense column, for a block's (y, *inputs) -> (phi, c); None when phi does not
-    depend on y (a clearance block). ``used``: `designopt.transcriptions.compiled.compiled_as`."""
-    y, params = block_symbols(terms)
-    phi, _ = terms(y, *params)
-    grad = ca.gradient(phi, y)
-    if not grad.nnz():
+    depend on y (a clearance block). ``used``: `designopt.transcriptions.compiled.compiled_as`; found in the cache
+    by ``terms`` and this derivation, as `block_jacobian_function` is."""
+    if not terms.jac_sparsity(0, 0).nnz():
         return None
-    return compiled(ca.Function("block_gradient", [y, *params], [ca.densify(grad)]), compile_mode, used)
+
+    def derive() -> ca.Function:
+        y, params = block_symbols(terms)
+        phi, _ = terms(y, *params)
+        return ca.Function("block_gradient", [y, *params], [ca.densify(ca.gradient(phi, y))])
+
+    return compiled_as("block_gradient", derivation_identity(terms, block_gradient_function), derive, compile_mode,
+                       used)
 
 
 def assemble_gradient(n_x: int, f_of: ca.Function | None,
@@ -129,6 +145,9 @@ def assemble_gradient(n_x: int, f_of: ca.Function | None,
     rows = np.concatenate([*rows, np.zeros(0, int)])
     # one 1 per column: block entry e adds to entry rows[e] of the gradient
     scatter = ca.DM(ccs_sparsity(n_x, len(rows), rows, np.arange(len(rows))), 1.0)
-    grad = ca.mtimes(scatter, ca.vertcat(*values)) if len(rows) else ca.MX(n_x, 1)
+    # dense: nlpsol hands IPOPT grad_f's nonzeros as the whole gradient, so an entry no term touches must be a
+    # stored 0 (given a structurally sparse one, IPOPT solved another problem: the pocket cell's starts went to
+    # the iteration cap; tests/test_collocation.py has the smallest case)
+    grad = ca.densify(ca.mtimes(scatter, ca.vertcat(*values)) if len(rows) else ca.MX(n_x, 1))
     f = not_computed(1) if f_of is None else f_of(X)
     return ca.Function("grad_f", [X, P], [f, grad], ["x", "p"], ["f", "grad_f_x"])

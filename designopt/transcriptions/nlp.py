@@ -17,9 +17,15 @@ import numpy as np
 
 from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
-from designopt.transcriptions.compiled import built_together, compiled, level
+from designopt.transcriptions.compiled import built_together, compiled_as, level
 from designopt.transcriptions.degeneracy import q_independent_rows
-from designopt.transcriptions.hessian import assemble_hessian, block_hessian_function, block_symbols, per_point
+from designopt.transcriptions.hessian import (
+    assemble_hessian,
+    block_hessian_function,
+    block_symbols,
+    derivation_identity,
+    per_point,
+)
 from designopt.transcriptions.jacobian import (
     assemble_gradient,
     assemble_jacobian,
@@ -226,9 +232,7 @@ class NLP:
                 self._values[compile_mode] = (ca.Function("nlp_f", [self.x], [self.f]),
                                               ca.Function("nlp_g", [self.x], [self.g]))
             else:
-                groups = [(*(None if fn is None else compiled(fn, self._level(b, compile_mode),
-                                                              self._used(compile_mode))
-                             for fn in split_terms(b.terms)),
+                groups = [(*compiled_split_terms(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
                            b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
                 self._values[compile_mode] = assemble_values(
                     self.x, self.n_constraints, self.constraints.rows, groups,
@@ -311,6 +315,16 @@ def split_terms(terms: ca.Function) -> tuple[ca.Function | None, ca.Function | N
     phi, c = terms(y, *params)
     return (None if phi.is_zero() else ca.Function(f"{terms.name()}_phi", [y, *params], [phi]),
             ca.Function(f"{terms.name()}_c", [y, *params], [c]) if c.numel() else None)
+
+
+def compiled_split_terms(terms: ca.Function, compile_mode: str,
+                         used: list | None = None) -> tuple[ca.Function | None, ca.Function | None]:
+    """`split_terms` compiled per ``compile_mode``, each found in the cache by ``terms`` and the split (not by its
+    own serialised graph, which a warm build would otherwise serialise again); ``used``:
+    `designopt.transcriptions.compiled.compiled_as`."""
+    return tuple(None if fn is None else compiled_as(fn.name(), derivation_identity(terms, split_terms, part),
+                                                     lambda fn=fn: fn, compile_mode, used)
+                 for part, fn in enumerate(split_terms(terms)))
 
 
 def assemble_values(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX],
