@@ -265,6 +265,26 @@ def test_jacobian_gradient_and_split_blocks_found_in_the_cache_are_not_derived_a
     assert serialised == ["terms"] * 4 and sorted(tmp_path.glob("*.so")) == libraries
 
 
+def test_a_derivations_source_in_the_cache_key_is_what_inspect_gives():
+    """The compile cache keys a derived block by its derivation's source: read from the lines its code comes from
+    (not by tokenising the module), it is `inspect.getsource`'s text for every derivation the blocks use, so keys
+    did not move; a derivation with a nested function and a statement over several lines included."""
+    import inspect
+
+    from designopt.transcriptions.hessian import _source, block_hessian_function
+    from designopt.transcriptions.jacobian import block_gradient_function, block_jacobian_function
+
+    def ends_in_a_nested_function(scale):
+        def derive():
+            return scale * 2
+
+    for derivation in (block_hessian_function, block_jacobian_function, block_gradient_function, split_terms,
+                       ends_in_a_nested_function):
+        assert _source(derivation) == inspect.getsource(derivation)
+    assert "def derive()" in _source(block_jacobian_function)
+    assert _source(block_gradient_function).rstrip().endswith("compile_mode,\n                       used)")
+
+
 def test_a_gradient_with_entries_no_term_touches_is_dense_and_ipopt_reads_it_right():
     """nlpsol hands IPOPT the nonzeros of the grad_f it is given as the whole gradient: a gradient output without
     stored entries for the variables no objective term touches (the points only a clearance block covers) would
