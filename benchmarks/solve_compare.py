@@ -12,6 +12,11 @@ mean the same solves to the bit. At the end, the median over the rounds of the r
 
     .venv/bin/python benchmarks/solve_compare.py --against HEAD [--config configs/milling.yaml] [--starts 48]
         [--rounds 8] [--waypoints 10]
+
+With ``--build``, each process instead builds and prepares the config's NLP (the full path, the search's profile)
+from the compile cache and prints its wall and CPU seconds (`speed_table.py --build-only`'s measure); a first round,
+not counted, fills the cache for both checkouts, so the rounds compare warm builds. At the end, the medians of each
+checkout and their ratio.
 """
 
 from __future__ import annotations
@@ -63,6 +68,42 @@ def measure(config: str, waypoints: int, starts: int) -> None:
     print(f"{ms:.4f} {iterations} {digest.hexdigest()[:12]}")
 
 
+def measure_build(config: str) -> None:
+    """One process's build (``--child --build``): wall and CPU seconds of building and preparing the NLP."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from speed_table import setup
+
+    from designopt.solve import local
+    from designopt.transcriptions import Collocation
+
+    problem, search = setup(config, 0, "full")
+    wall, cpu = time.perf_counter(), time.process_time()
+    local.prepared(problem, Collocation(), search.profile)
+    print(f"{time.perf_counter() - wall:.4f} {time.process_time() - cpu:.4f}")
+
+
+def compare_builds(against: str, config: str, rounds: int) -> None:
+    """Warm builds of ``config`` by ``against``'s library and this checkout's, a fresh process each, alternating."""
+    command = [sys.executable, __file__, "--child", "--build", "--config", config]
+    walls: dict[str, list[float]] = {"against": [], "this": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        checkouts = (("against", {**os.environ, "PYTHONPATH": str(export(against, Path(tmp)))}),
+                     ("this", {**os.environ, "PYTHONPATH": str(ROOT)}))
+        for r in range(rounds + 1):  # round 0 fills the compile cache for both
+            row = {}
+            for name, env in checkouts:
+                out = subprocess.run(command, check=True, capture_output=True, text=True, cwd=ROOT, env=env)
+                row[name] = tuple(float(v) for v in out.stdout.split()[-2:])
+                if r:
+                    walls[name].append(row[name][0])
+            if r:
+                print(f"round {r}: {against} {row['against'][0]:.3f} s (CPU {row['against'][1]:.3f}), this "
+                      f"{row['this'][0]:.3f} s (CPU {row['this'][1]:.3f})", flush=True)
+    a, b = statistics.median(walls["against"]), statistics.median(walls["this"])
+    print(f"{config}, warm build, {rounds} rounds: {against} {a:.3f} s, this {b:.3f} s median wall "
+          f"({min(walls['this']):.3f}-{max(walls['this']):.3f}): {b / a:.3f}x")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--against", required=False, help="git revision to compare with")
@@ -70,14 +111,18 @@ def main() -> None:
     parser.add_argument("--starts", type=int, default=48)
     parser.add_argument("--rounds", type=int, default=8)
     parser.add_argument("--waypoints", type=int, default=10, help="0: the full path")
+    parser.add_argument("--build", action="store_true", help="compare warm NLP builds instead of solves")
     parser.add_argument("--child", action="store_true",
                         help="measure this checkout in this process only (what each round runs; e.g. under perf)")
     args = parser.parse_args()
     if args.child:
-        measure(args.config, args.waypoints, args.starts)
+        measure_build(args.config) if args.build else measure(args.config, args.waypoints, args.starts)
         return
     if not args.against:
         parser.error("--against REVISION is required")
+    if args.build:
+        compare_builds(args.against, args.config, args.rounds)
+        return
     command = [sys.executable, __file__, "--child", "--config", args.config, "--starts", str(args.starts),
                "--waypoints", str(args.waypoints)]
     with tempfile.TemporaryDirectory() as tmp:
