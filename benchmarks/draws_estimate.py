@@ -149,7 +149,10 @@ def main() -> None:
     parser.add_argument("--max-draws", type=int, default=5, help="with --confirm: at most this many draws")
     args = parser.parse_args()
     known = json.loads(args.reference.read_text())["metrics"]["design_cost"]
-    runs = sorted(args.runs, key=lambda run: int(run.name.lstrip("s")))
+    for run in args.runs:  # a glob that matched nothing reaches here as itself
+        if not (run.is_dir() and run.name.startswith("s") and run.name[1:].isdigit()):
+            parser.error(f"{run}: not a run directory of search_seeds.py (DIR/<config name>/s<seed>)")
+    runs = sorted(args.runs, key=lambda run: int(run.name[1:]))
     if args.confirm:
         print(f"draws until {args.confirm} reach the answer (within {args.within:g}x), at most {args.max_draws}; "
               "answers / best known")

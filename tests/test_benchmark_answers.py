@@ -81,3 +81,18 @@ def test_the_confirm_table_says_what_the_rule_answers_over_every_draw_given(tmp_
            "the answer 1.0127x it" in out
     assert "seed 6: draws 1.068, 1.094, 1.072x; answer 1.068x after 3 draws\n" in out
     assert "2 seeds settled" in out and "draws made 2.50 on average, at most 3" in out
+
+
+def test_runs_that_are_not_run_directories_are_one_line_errors(tmp_path):
+    """A glob that matched nothing (`DIR/<name>/s*` with the wrong name) or a file given as a run is refused in one
+    line with exit code 2, not a traceback."""
+    import subprocess
+
+    script = Path(__file__).resolve().parent.parent / "benchmarks" / "draws_estimate.py"
+    reference = Path(__file__).resolve().parent.parent / "benchmarks" / "reference" / "milling_best_known.json"
+    (tmp_path / "s12").write_text("not a run")
+    for run in (tmp_path / "wrong" / "s*", tmp_path / "s12"):
+        proc = subprocess.run([sys.executable, str(script), str(run), "--reference", str(reference)],
+                              capture_output=True, text=True)
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr
+        assert f"{run}: not a run directory" in proc.stderr.strip().splitlines()[-1]
