@@ -13,8 +13,8 @@ mean the same solves to the bit. At the end, the median over the rounds of the r
     .venv/bin/python benchmarks/solve_compare.py --against HEAD [--config configs/milling.yaml] [--starts 48]
         [--rounds 8] [--waypoints 10]
 
-With ``--build``, each process instead builds and prepares the config's NLP (the full path, the search's profile)
-from the compile cache and prints its wall and CPU seconds (`speed_table.py --build-only`'s measure); a first round,
+With ``--build``, each process is instead `speed_table.py --build-only CONFIG`: it builds and prepares the config's
+NLP (the full path, the search's profile) from the compile cache and prints its wall and CPU seconds; a first round,
 not counted, fills the cache for both checkouts, so the rounds compare warm builds. At the end, the medians of each
 checkout and their ratio.
 """
@@ -68,30 +68,21 @@ def measure(config: str, waypoints: int, starts: int) -> None:
     print(f"{ms:.4f} {iterations} {digest.hexdigest()[:12]}")
 
 
-def measure_build(config: str) -> None:
-    """One process's build (``--child --build``): wall and CPU seconds of building and preparing the NLP."""
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    from speed_table import setup
-
-    from designopt.solve import local
-    from designopt.transcriptions import Collocation
-
-    problem, search = setup(config, 0, "full")
-    wall, cpu = time.perf_counter(), time.process_time()
-    local.prepared(problem, Collocation(), search.profile)
-    print(f"{time.perf_counter() - wall:.4f} {time.process_time() - cpu:.4f}")
+def checkouts(against: str, tmp: str) -> tuple[tuple[str, dict], tuple[str, dict]]:
+    """(name, environment) of ``against``'s library (exported under ``tmp``) and of this checkout's."""
+    return (("against", {**os.environ, "PYTHONPATH": str(export(against, Path(tmp)))}),
+            ("this", {**os.environ, "PYTHONPATH": str(ROOT)}))
 
 
 def compare_builds(against: str, config: str, rounds: int) -> None:
     """Warm builds of ``config`` by ``against``'s library and this checkout's, a fresh process each, alternating."""
-    command = [sys.executable, __file__, "--child", "--build", "--config", config]
+    command = [sys.executable, str(ROOT / "benchmarks" / "speed_table.py"), "--build-only", config]
     walls: dict[str, list[float]] = {"against": [], "this": []}
     with tempfile.TemporaryDirectory() as tmp:
-        checkouts = (("against", {**os.environ, "PYTHONPATH": str(export(against, Path(tmp)))}),
-                     ("this", {**os.environ, "PYTHONPATH": str(ROOT)}))
+        both = checkouts(against, tmp)
         for r in range(rounds + 1):  # round 0 fills the compile cache for both
             row = {}
-            for name, env in checkouts:
+            for name, env in both:
                 out = subprocess.run(command, check=True, capture_output=True, text=True, cwd=ROOT, env=env)
                 row[name] = tuple(float(v) for v in out.stdout.split()[-2:])
                 if r:
@@ -116,22 +107,21 @@ def main() -> None:
                         help="measure this checkout in this process only (what each round runs; e.g. under perf)")
     args = parser.parse_args()
     if args.child:
-        measure_build(args.config) if args.build else measure(args.config, args.waypoints, args.starts)
+        measure(args.config, args.waypoints, args.starts)
         return
     if not args.against:
         parser.error("--against REVISION is required")
-    if args.build:
+    if args.build:  # each process speed_table.py's --build-only
         compare_builds(args.against, args.config, args.rounds)
         return
     command = [sys.executable, __file__, "--child", "--config", args.config, "--starts", str(args.starts),
                "--waypoints", str(args.waypoints)]
     with tempfile.TemporaryDirectory() as tmp:
-        checkouts = (("against", {**os.environ, "PYTHONPATH": str(export(args.against, Path(tmp)))}),
-                     ("this", {**os.environ, "PYTHONPATH": str(ROOT)}))
+        both = checkouts(args.against, tmp)
         ratios, digests = [], set()
         for r in range(args.rounds):
             row = {}
-            for name, env in checkouts:
+            for name, env in both:
                 out = subprocess.run(command, check=True, capture_output=True, text=True, cwd=ROOT, env=env)
                 ms, iterations, digest = out.stdout.split()[-3:]
                 row[name] = (float(ms), int(iterations), digest)

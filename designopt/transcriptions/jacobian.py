@@ -37,6 +37,7 @@ def block_jacobian_function(terms: ca.Function, compile_mode: str,
         J = ca.jacobian(c, y)
         if J.sparsity() != pattern:
             raise AssertionError(f"the Jacobian of {terms.name()}'s c has other nonzeros than its sparsity says")
+        # vertcat of the nonzeros, not nz[:]: the generated C (so its bits) is the one the solves were checked with
         return ca.Function("block_jacobian", [y, *params], [ca.vertcat(*J.nonzeros()) if J.nnz() else ca.SX(0, 1)])
 
     rows, cols = pattern.get_triplet()
