@@ -23,6 +23,7 @@ import numpy as np
 
 import designopt.transcriptions.quadratic as quadratic_terms
 from designopt.problem import DesignProblem
+from designopt.transcriptions.affine import Affine
 from designopt.transcriptions.base import InitialGuess, waypoint_function
 from designopt.transcriptions.nlp import (
     NLP,
@@ -125,8 +126,6 @@ class CollocationNLP:
 
         terms, c_lo, c_hi = waypoint_terms(problem, scheme.tracking, position_in_terms=not differential)
 
-        Q0, V0, Q1, V1 = Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:]
-        Q_mid, V_mid = hermite_midpoint(Q0, V0, Q1, V1, h)
         q_index = n_d + np.arange(N)[:, None] * self.n_state + np.arange(n_m)[None, :]
         # The smoothness term must stay small against the design cost: the figure-eight needs joint
         # accelerations of ~100 rad per unit task time squared, so 1e-6 already outweighed L_d (measured).
@@ -152,6 +151,7 @@ class CollocationNLP:
             wp = waypoint_function(problem)
             p_W, _, _, Jv = wp.map(N)(Q, ca.repmat(q_d, 1, N), S, F)
             h3 = tp.dt if tp.uniform else ca.DM(np.tile(tp.h, (3, 1)))
+            Q_mid, V_mid = hermite_midpoint(Q[:, :-1], V[:, :-1], Q[:, 1:], V[:, 1:], h)
             _, _, _, Jv_mid = wp.map(N - 1)(Q_mid, ca.repmat(q_d, 1, N - 1), S[:, :-1], F[:, :-1])
             pdot, pdot_mid = _pdot(Jv, V, n_m, N), _pdot(Jv_mid, V_mid, n_m, N - 1)
             cons.add(P[:, 0] - p_W[:, 0], 0.0, 0.0)
@@ -169,11 +169,17 @@ class CollocationNLP:
         lo_m = np.array([j.lower for j in chain.moving])
         hi_m = np.array([j.upper for j in chain.moving])
         vmax = np.tile(problem.velocity_limits[:, None], (1, N - 1))
-        cons.add(Q_mid, np.tile(lo_m[:, None], (1, N - 1)), np.tile(hi_m[:, None], (1, N - 1)))
-        cons.add(V_mid, -vmax, vmax)
+        # the midpoint rows are affine in the knots: their Jacobian stated, not derived (`transcriptions.affine`)
+        z_index = n_d + np.arange(N)[None, :] * self.n_state + np.arange(self.n_state)[:, None]
+        knots = (z_index[:n_m, :-1], z_index[n_m : 2 * n_m, :-1], z_index[:n_m, 1:], z_index[n_m : 2 * n_m, 1:])
+        steps = (tp.dt if tp.uniform else np.tile(tp.h, (n_m, 1)),)  # as h above
+        cons.add(Affine(_mid_q, x, knots, steps),
+                 np.tile(lo_m[:, None], (1, N - 1)), np.tile(hi_m[:, None], (1, N - 1)))
+        cons.add(Affine(_mid_v, x, knots, steps), -vmax, vmax)
         cell_blocks = []
         if problem.cell is not None:
-            cons.add(M - Q_mid, 0.0, 0.0)
+            m_index = n_d + N * self.n_state + np.arange(N - 1)[None, :] * n_m + np.arange(n_m)[:, None]
+            cons.add(Affine(_mid_tie, x, (m_index, *knots), steps), 0.0, 0.0)
             clear = clearance_terms(problem)
             n_cl = clear.size1_out(1)
             mid_index = (n_d + N * self.n_state + np.arange(N - 1)[:, None] * n_m + np.arange(n_m)[None, :])
@@ -227,6 +233,21 @@ class CollocationNLP:
         Z = x[n_d : n_d + N * self.n_state].reshape(N, self.n_state)
         drift = float(self._drift(x)) if self.scheme.kinematics == "differential" else 0.0
         return x[:n_d], self.scheme.trajectory(self.problem.toolpath.t, Z[:, :n_m], Z[:, n_m : 2 * n_m]), drift
+
+
+def _mid_q(q0, v0, q1, v1, h):
+    """The joints at an interval's midpoint (`hermite_midpoint`): an `Affine` row's function."""
+    return hermite_midpoint(q0, v0, q1, v1, h)[0]
+
+
+def _mid_v(q0, v0, q1, v1, h):
+    """The joint velocities at an interval's midpoint (`hermite_midpoint`): an `Affine` row's function."""
+    return hermite_midpoint(q0, v0, q1, v1, h)[1]
+
+
+def _mid_tie(m, q0, v0, q1, v1, h):
+    """A collocation point's joint variable tied to the cubic: an `Affine` row's function."""
+    return m - hermite_midpoint(q0, v0, q1, v1, h)[0]
 
 
 def _pdot(Jv_W, V, n_m: int, n: int):

@@ -22,6 +22,7 @@ import numpy as np
 
 import designopt.transcriptions.quadratic as quadratic_terms
 from designopt.problem import DesignProblem
+from designopt.transcriptions.affine import Affine
 from designopt.transcriptions.base import InitialGuess
 from designopt.transcriptions.nlp import (
     NLP,
@@ -93,7 +94,8 @@ class ForwardKinematicsNLP:
                                  tracking_rows(problem, "epsilon")))
         if scheme.continuous:
             step = problem.max_steps.T
-            cons.add(Q[:, 1:] - Q[:, :-1], -step, step)
+            # affine: the Jacobian stated, not derived (`transcriptions.affine`)
+            cons.add(Affine(_step, x, (q_index.T[:, :-1], q_index.T[:, 1:])), -step, step)
 
         lo_m = [j.lower for j in chain.moving]
         hi_m = [j.upper for j in chain.moving]
@@ -111,3 +113,8 @@ class ForwardKinematicsNLP:
     def unpack(self, x: np.ndarray) -> tuple[np.ndarray, PiecewiseLinear, float]:
         n_d, n_m, N = self.problem.chain.n_design, self.problem.chain.n_moving, self.problem.toolpath.n
         return x[:n_d], self.scheme.trajectory(self.problem.toolpath.t, x[n_d:].reshape(N, n_m)), 0.0
+
+
+def _step(q0, q1):
+    """The joints' step from one waypoint to the next: an `Affine` row's function."""
+    return q1 - q0

@@ -56,8 +56,14 @@ def unclaimed_rows(n_g: int, mu_indices: list[np.ndarray]) -> np.ndarray:
     return np.flatnonzero(~claimed)
 
 
+def none_constant(rows: np.ndarray) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+    """The ``constant_rows`` of `assemble_jacobian` for rows with no stated Jacobian: none covered."""
+    return (np.zeros(0, int), np.zeros(0, int), np.zeros(0)), rows
+
+
 def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: ca.Function | None,
-                      groups: list[tuple[ca.Function, np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]]
+                      groups: list[tuple[ca.Function, np.ndarray, np.ndarray, np.ndarray, list, np.ndarray]],
+                      constant_rows: Callable[[np.ndarray], tuple[tuple, np.ndarray]] = none_constant
                       ) -> ca.Function:
     """jac_g(x, p) -> (g, dg/dx), for nlpsol's ``jac_g`` option.
 
@@ -67,12 +73,16 @@ def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: 
     (block, rows, cols, y_index, block_inputs, mu_index) with ``block``, ``rows``, ``cols`` from
     `block_jacobian_function`, ``y_index`` (N x n_y) the position in x of each block variable, ``mu_index``
     (N x n_c) the position in g of each block row and ``block_inputs`` the block's constant extra inputs (mapped).
-    Rows of g in no group are differentiated from their own expressions.
+    Rows of g in no group are differentiated from their own expressions, except those whose constant Jacobian
+    ``constant_rows`` states (row indices -> ((rows, cols, values) with rows in g, the rows it does not cover):
+    `ConstraintList.constant_jacobian`).
     """
     n_x = x.shape[0]
     triplets = [(mu_index[:, rows].ravel(), y_index[:, cols].ravel())  # point by point, as map stacks them
                 for _, rows, cols, y_index, _, mu_index in groups]
     rest = unclaimed_rows(n_g, [mu_index for *_, mu_index in groups])
+    (a_rows, a_cols, a_values), rest = constant_rows(rest)
+    triplets.append((a_rows, a_cols))
     J_rest = ca.jacobian(g_rows(rest) if rest.size else ca.SX(0, 1), x)
     r_rows, r_cols = (np.asarray(a, int) for a in J_rest.sparsity().get_triplet())
     triplets.append((rest[r_rows], r_cols))
@@ -89,9 +99,11 @@ def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: 
     values = []
     for block, _, _, y_index, block_inputs, _ in groups:
         values.append(ca.vec(block.map(y_index.shape[0])(per_point(X, y_index), *block_inputs)))
-    # its nonzeros as one column by slicing (`nz[:]`): vertcat of the Python list of SX scalars was a fifth of a
-    # 1,208-waypoint program's warm build
-    rest_fn = ca.Function("jac_rest", [x], [J_rest.nz[:] if J_rest.nnz() else ca.SX(0, 1)])
+    if a_rows.size:
+        values.append(ca.MX(ca.DM(a_values)))
+    # its nonzeros as one column by slicing (`nz[:]`, a row when J_rest is one row, hence vec): vertcat of the
+    # Python list of SX scalars was a fifth of a 1,208-waypoint program's warm build
+    rest_fn = ca.Function("jac_rest", [x], [ca.vec(J_rest.nz[:]) if J_rest.nnz() else ca.SX(0, 1)])
     values.append(rest_fn(X))
     nz = ca.vertcat(*values)[ca.DM(order.tolist())]
     g = not_computed(n_g) if g_of is None else g_of(X)

@@ -17,6 +17,7 @@ import numpy as np
 
 from designopt.costs import tracking_residual
 from designopt.problem import DesignProblem
+from designopt.transcriptions.affine import Affine
 from designopt.transcriptions.compiled import built_together, compiled_as, level
 from designopt.transcriptions.degeneracy import q_independent_rows
 from designopt.transcriptions.hessian import (
@@ -67,21 +68,23 @@ def deferred_terms(terms: ca.Function, y, inputs: tuple, quadratic: tuple[Quadra
 
 
 def _built(expr):
-    """An entry of a `ConstraintList` as SX: a `Deferred` one built."""
+    """An entry of a `ConstraintList` as SX: a `Deferred` one built, an `Affine` one's expression."""
+    if isinstance(expr, Affine):
+        return expr.expression
     return expr.value if isinstance(expr, Deferred) else expr
 
 
 @dataclass
 class ConstraintList:
     """Constraints and their bounds, stacked in the order added (CasADi's column-major vec); an entry may be
-    `Deferred`."""
+    `Deferred`, or `Affine` (its constant Jacobian stated, `constant_jacobian`)."""
 
     def __post_init__(self):
         self.g, self.lo, self.hi = [], [], []
 
     def add(self, expr, lo, hi) -> None:
-        expr = expr if isinstance(expr, Deferred) else ca.vec(expr)
-        rows = expr.rows if isinstance(expr, Deferred) else expr.shape[0]
+        expr = expr if isinstance(expr, (Deferred, Affine)) else ca.vec(expr)
+        rows = expr.rows if isinstance(expr, Deferred) else expr.size if isinstance(expr, Affine) else expr.shape[0]
         self.g.append(expr)
         self.lo.append(np.broadcast_to(np.ravel(lo, order="F"), rows))
         self.hi.append(np.broadcast_to(np.ravel(hi, order="F"), rows))
@@ -105,6 +108,36 @@ class ConstraintList:
             return ca.SX(0, 1)
         where = {int(row): i for i, row in enumerate(np.concatenate(taken))}
         return ca.vertcat(*parts)[ca.DM([where[int(row)] for row in index])]
+
+    def constant_jacobian(self, index: np.ndarray) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+        """((rows, cols, values), others): the Jacobian of the rows ``index`` of g that lie in `Affine` entries, as
+        triplets with rows numbered in g, and the rows of ``index`` that do not (ascending)."""
+        index = np.asarray(index, dtype=int)
+        starts = np.cumsum([0, *(len(lo) for lo in self.lo)])
+        wanted = np.zeros(starts[-1], dtype=bool)
+        wanted[index] = True
+        affine = np.zeros(starts[-1], dtype=bool)
+        rows, cols, values = [np.zeros(0, int)], [np.zeros(0, int)], [np.zeros(0)]
+        for k, expr in enumerate(self.g):
+            if isinstance(expr, Affine) and wanted[starts[k]:starts[k + 1]].any():
+                r, c, v = expr.jacobian
+                keep = wanted[starts[k] + r]
+                rows.append(starts[k] + r[keep])
+                cols.append(c[keep])
+                values.append(v[keep])
+                affine[starts[k]:starts[k + 1]] = True
+        return tuple(np.concatenate(a) for a in (rows, cols, values)), np.flatnonzero(wanted & ~affine)
+
+    def affine_groups(self) -> list[tuple[ca.Function, np.ndarray, list, np.ndarray]]:
+        """Each `Affine` entry as a group of one-row blocks: (function, y_index, [constants], mu_index) with
+        ``mu_index`` (entries x 1) its rows in g (`Affine.function`, `Affine.points`)."""
+        starts = np.cumsum([0, *(len(lo) for lo in self.lo)])
+        groups = []
+        for k, expr in enumerate(self.g):
+            if isinstance(expr, Affine):
+                y_index, constants = expr.points()
+                groups.append((expr.function, y_index, [constants], starts[k] + np.arange(expr.size)[:, None]))
+        return groups
 
     def stacked(self):
         """(g, lower bounds, upper bounds), every deferred entry built."""
@@ -217,7 +250,8 @@ class NLP:
                 groups = [(*block_jacobian_function(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
                            b.y_index, self._inputs(b), b.mu_index)
                           for b in self.blocks]
-                jacobian = assemble_jacobian(self.x, self.n_constraints, self.constraints.rows, None, groups)
+                jacobian = assemble_jacobian(self.x, self.n_constraints, self.constraints.rows, None, groups,
+                                             self.constraints.constant_jacobian)
             self._jacobians[compile_mode, values] = jacobian
         return self._jacobians[compile_mode, values]
 
@@ -234,6 +268,7 @@ class NLP:
             else:
                 groups = [(*compiled_split_terms(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
                            b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
+                groups += [(None, *group) for group in self.constraints.affine_groups()]
                 self._values[compile_mode] = assemble_values(
                     self.x, self.n_constraints, self.constraints.rows, groups,
                     compiled_terms(self.quadratic, compile_mode, self._used(compile_mode)))
