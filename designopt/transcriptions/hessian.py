@@ -27,7 +27,8 @@ def per_point(v: ca.MX, index: np.ndarray) -> ca.MX:
     n_points, n = index.shape
     if not index.size:
         return ca.MX(n, n_points)
-    return ca.reshape(v[ca.DM(index.T.ravel(order="F").tolist())], n, n_points)
+    # a list of ints, not a DM of them: SWIG reads ints into an index directly, half the time of a DM of doubles
+    return ca.reshape(v[index.T.ravel(order="F").tolist()], n, n_points)
 
 
 def ccs_sparsity(n_rows: int, n_cols: int, rows: np.ndarray, cols: np.ndarray) -> ca.Sparsity:

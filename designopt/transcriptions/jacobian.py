@@ -105,7 +105,7 @@ def assemble_jacobian(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX], g_of: 
     # Python list of SX scalars was a fifth of a 1,208-waypoint program's warm build
     rest_fn = ca.Function("jac_rest", [x], [ca.vec(J_rest.nz[:]) if J_rest.nnz() else ca.SX(0, 1)])
     values.append(rest_fn(X))
-    nz = ca.vertcat(*values)[ca.DM(order.tolist())]
+    nz = ca.vertcat(*values)[order.tolist()] if order.size else ca.MX(0, 1)
     g = not_computed(n_g) if g_of is None else g_of(X)
     return ca.Function("jac_g", [X, P], [g, ca.MX(sp, nz)], ["x", "p"], ["g", "jac_g_x"])
 

@@ -391,7 +391,7 @@ def assemble_values(x, n_g: int, g_rows: Callable[[np.ndarray], ca.SX],
         rows.append(rest)
     position = np.empty(n_g, dtype=int)
     position[np.concatenate([*rows, np.zeros(0, int)])] = np.arange(n_g)
-    G = ca.vertcat(*values)[ca.DM(position.tolist())] if n_g else ca.MX(0, 1)
+    G = ca.vertcat(*values)[position.tolist()] if n_g else ca.MX(0, 1)
     return ca.Function("nlp_f", [X], [f]), ca.Function("nlp_g", [X], [G])
 
 
