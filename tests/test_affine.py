@@ -77,6 +77,23 @@ def test_the_assembled_jacobian_of_affine_rows_is_the_derived_one(rng):
     np.testing.assert_array_equal(np.array(a.nonzeros()), np.array(b.nonzeros()))
 
 
+def test_every_affine_operation_gives_casadis_derivative_to_the_bit(rng):
+    """Sums and differences with numbers on either side, negation, products and quotients by constants and by
+    arrays of them."""
+    x, knots, mid, h = _layout(rng, uniform=False)
+
+    def fn(a, b, c, step):
+        return 2.0 - a / step + 3.0 * b - (b + 1.0) + (-c) * 0.7 + 1.0 + step * (c - 0.1) / 3.0
+
+    entry = Affine(fn, x, knots[:3], (h,))
+    rows, cols, values = entry.jacobian
+    derived = ca.jacobian(entry.expression, x)
+    stated = np.zeros((entry.size, x.shape[0]))
+    stated[rows, cols] = values
+    assert derived.nnz() == len(values)
+    np.testing.assert_array_equal(stated, np.array(ca.evalf(ca.densify(derived))))
+
+
 def test_rows_that_are_not_affine_or_not_elementwise_are_refused(rng):
     x, knots, mid, h = _layout(rng, uniform=True)
     with pytest.raises(TypeError, match="not affine"):
