@@ -44,14 +44,14 @@ class _Tangent:
 
     def __mul__(self, other):
         if isinstance(other, _Tangent):
-            raise TypeError("elementwise_affine: a product of two arguments is not affine")
+            raise TypeError("Affine: a product of two arguments is not affine")
         return _Tangent(other * self.d)
 
     __rmul__ = __mul__
 
     def __truediv__(self, other):
         if isinstance(other, _Tangent):
-            raise TypeError("elementwise_affine: a quotient of two arguments is not affine")
+            raise TypeError("Affine: a quotient of two arguments is not affine")
         return _Tangent((1.0 / np.asarray(other, float)) * self.d)
 
 
