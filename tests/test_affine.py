@@ -5,11 +5,6 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from designopt.config import parse_config
-from designopt.problem import problem_from_config
-from designopt.solve.local import prepared
-from designopt.solve.profile import SolverProfile
-from designopt.transcriptions import Collocation
 from designopt.transcriptions.affine import Affine
 from designopt.transcriptions.collocation import _mid_q, _mid_tie, _mid_v
 from designopt.transcriptions.forward_kinematics import _step
@@ -48,16 +43,13 @@ def test_the_stated_jacobian_is_casadis_derivative_of_the_expression_to_the_bit(
 
 
 @pytest.mark.parametrize("uniform", [True, False])
-def test_the_mapped_rows_are_the_expressions_values_to_the_bit(rng, uniform):
+def test_the_expression_is_fn_entry_by_entry_in_casadis_column_order(rng, uniform):
     x, knots, mid, h = _layout(rng, uniform)
     point = rng.normal(size=x.shape[0])
     for entry in _entries(x, knots, mid, h):
-        y_index, constants = entry.points()
-        mapped = np.array(entry.function.map(entry.size)(point[y_index].T, constants)).ravel()
         whole = np.array(ca.Function("whole", [x], [entry.expression])(point)).ravel()
-        np.testing.assert_array_equal(mapped, whole)
-        np.testing.assert_array_equal(mapped, np.ravel(entry.fn(*(point[i] for i in entry.index), *entry.constants),
-                                                        order="F"))
+        numeric = entry.fn(*(point[i] for i in entry.index), *entry.constants)
+        np.testing.assert_array_equal(whole, np.ravel(numeric, order="F"))
 
 
 def test_the_assembled_jacobian_of_affine_rows_is_the_derived_one(rng):
@@ -104,13 +96,3 @@ def test_rows_that_are_not_affine_or_not_elementwise_are_refused(rng):
         _ = Affine(lambda a, b: a - b, x, (knots[0], knots[0])).jacobian
     with pytest.raises(ValueError, match="differ in shape"):
         Affine(_step, x, (knots[0], mid[:, :-1]))
-
-
-def test_a_prepared_solver_builds_no_expression_of_the_affine_rows():
-    """A solve evaluates the affine rows mapped and takes their Jacobian as constants: the SX expression of all
-    rows is built only when asked for."""
-    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 8},
-           "robot": {"structure": "RRR", "dh": "generic"}, "placement": {"xyz": [0.4, 0.1, 0.0]}}
-    _, solver, _ = prepared(problem_from_config(parse_config(cfg)), Collocation(), SolverProfile(compile="none"))
-    affine = [e for e in solver.nlp.constraints.g if isinstance(e, Affine)]
-    assert len(affine) == 2 and not any("expression" in vars(e) for e in affine)

@@ -62,9 +62,9 @@ class Affine:
     constant), each index array (m x n, positions in the decision vector ``x``) of one shape and each constant a
     number or an m x n array.
 
-    A solve evaluates the rows as fn on scalars mapped over the entries (`function`, `points`: the same arithmetic
-    as the expression, so the same bits) and takes their Jacobian as constants (`jacobian`); the SX ``expression``
-    of all rows is built only when asked for."""
+    A solve evaluates the rows as their SX ``expression`` and takes their Jacobian as constants (`jacobian`).
+    (Evaluated instead as fn mapped over the entries or over chunks of columns, g cost 1.1-1.4x as much an
+    evaluation: docs/decisions.md, 2026-12-07.)"""
 
     fn: Callable
     x: ca.SX
@@ -81,24 +81,10 @@ class Affine:
 
     @functools.cached_property
     def expression(self) -> ca.SX:
-        """The rows as one SX column of ``x`` (built on first use)."""
+        """The rows as one SX column of ``x`` (built on first use: the rows' values in a solve)."""
         shape = np.shape(self.index[0])
         args = [ca.reshape(self.x[ca.DM(np.ravel(i, order="F").tolist())], *shape) for i in self.index]
         return ca.vec(self.fn(*args, *(ca.DM(c) if np.ndim(c) else c for c in self.constants)))
-
-    @functools.cached_property
-    def function(self) -> ca.Function:
-        """(y, c) -> the row at one entry: y its k arguments, c its constants."""
-        y, c = ca.SX.sym("y", len(self.index)), ca.SX.sym("c", len(self.constants))
-        return ca.Function("affine", [y, c], [self.fn(*ca.vertsplit(y), *ca.vertsplit(c))], ["y", "c"], ["g"])
-
-    def points(self) -> tuple[np.ndarray, ca.DM]:
-        """(y_index, constants): the positions in x of every entry's arguments (entries x k, in row order) and its
-        constants (one column per entry), the inputs `function` is mapped over."""
-        y_index = np.stack([np.ravel(i, order="F") for i in self.index], axis=1)
-        shape = np.shape(self.index[0])
-        constants = [np.broadcast_to(np.asarray(c, float), shape).ravel(order="F") for c in self.constants]
-        return y_index, ca.DM(np.vstack(constants) if constants else np.zeros((0, self.size)))
 
     @functools.cached_property
     def jacobian(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -128,17 +128,6 @@ class ConstraintList:
                 affine[starts[k]:starts[k + 1]] = True
         return tuple(np.concatenate(a) for a in (rows, cols, values)), np.flatnonzero(wanted & ~affine)
 
-    def affine_groups(self) -> list[tuple[ca.Function, np.ndarray, list, np.ndarray]]:
-        """Each `Affine` entry as a group of one-row blocks: (function, y_index, [constants], mu_index) with
-        ``mu_index`` (entries x 1) its rows in g (`Affine.function`, `Affine.points`)."""
-        starts = np.cumsum([0, *(len(lo) for lo in self.lo)])
-        groups = []
-        for k, expr in enumerate(self.g):
-            if isinstance(expr, Affine):
-                y_index, constants = expr.points()
-                groups.append((expr.function, y_index, [constants], starts[k] + np.arange(expr.size)[:, None]))
-        return groups
-
     def stacked(self):
         """(g, lower bounds, upper bounds), every deferred entry built."""
         return (ca.vertcat(*(_built(e) for e in self.g)), *self.bounds())
@@ -268,7 +257,6 @@ class NLP:
             else:
                 groups = [(*compiled_split_terms(b.terms, self._level(b, compile_mode), self._used(compile_mode)),
                            b.y_index, self._inputs(b), b.mu_index) for b in self.blocks]
-                groups += [(None, *group) for group in self.constraints.affine_groups()]
                 self._values[compile_mode] = assemble_values(
                     self.x, self.n_constraints, self.constraints.rows, groups,
                     compiled_terms(self.quadratic, compile_mode, self._used(compile_mode)))
