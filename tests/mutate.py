@@ -571,8 +571,11 @@ MUTATIONS = [
              "triplets = [(np.roll(mu_index, 1, axis=0)[:, rows].ravel(), y_index[:, cols].ravel())",
              ("tests/test_transcriptions.py", "tests/test_clearance.py")),
     Mutation("the rows outside the blocks left out of the Jacobian", "designopt/transcriptions/jacobian.py",
-             "    values.append(rest_fn(X))\n", "    values.append(0 * rest_fn(X))\n",
+             "        values.append(ca.MX(ca.DM(a_values)))", "        values.append(0 * ca.MX(ca.DM(a_values)))",
              ("tests/test_transcriptions.py", "tests/test_clearance.py")),
+    Mutation("the rows outside the blocks and not affine left out of the Jacobian",
+             "designopt/transcriptions/jacobian.py",
+             "    values.append(rest_fn(X))\n", "    values.append(0 * rest_fn(X))\n", ("tests/test_affine.py",)),
     Mutation("the objective's block gradient scattered one waypoint late", "designopt/transcriptions/jacobian.py",
              "            rows.append(y_index.ravel())", "            rows.append(np.roll(y_index, 1, axis=0).ravel())",
              ("tests/test_transcriptions.py", "tests/test_clearance.py")),
@@ -928,13 +931,16 @@ def run_tests(tree: Path, cache: Path, tests: list[str]) -> tuple[bool, str]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", help="run only mutations whose name contains this text")
+    parser.add_argument("--file", action="append", default=[],
+                        help="run only mutations of files whose path contains this text (repeatable)")
     parser.add_argument("--from", dest="first", type=int, default=1, metavar="K",
                         help="start at mutation K, numbered as a run without it prints them (to finish a run cut "
                              "short)")
     parser.add_argument("--tests", nargs="+", default=TESTS, help="test files to run (default: the fast ones "
                                                                   "that guard the objective)")
     args = parser.parse_args()
-    chosen = [m for m in MUTATIONS if not args.only or args.only in m.name]
+    chosen = [m for m in MUTATIONS if (not args.only or args.only in m.name)
+              and (not args.file or any(f in m.file for f in args.file))]
     numbered = list(enumerate(chosen, 1))[max(args.first, 1) - 1:]
     with tempfile.TemporaryDirectory(prefix="designopt-mutate-") as tmp:
         tmp = Path(tmp)
