@@ -170,19 +170,18 @@ class CollocationNLP:
         hi_m = np.array([j.upper for j in chain.moving])
         vmax = np.tile(problem.velocity_limits[:, None], (1, N - 1))
         # the midpoint rows are affine in the knots: their Jacobian stated, not derived (`transcriptions.affine`)
-        z_index = n_d + np.arange(N)[None, :] * self.n_state + np.arange(self.n_state)[:, None]
-        knots = (z_index[:n_m, :-1], z_index[n_m : 2 * n_m, :-1], z_index[:n_m, 1:], z_index[n_m : 2 * n_m, 1:])
+        q_at, v_at = q_index.T, (q_index + n_m).T  # n_m x N, as Q and V
+        knots = (q_at[:, :-1], v_at[:, :-1], q_at[:, 1:], v_at[:, 1:])
         steps = (tp.dt if tp.uniform else np.tile(tp.h, (n_m, 1)),)  # as h above
         cons.add(Affine(_mid_q, x, knots, steps),
                  np.tile(lo_m[:, None], (1, N - 1)), np.tile(hi_m[:, None], (1, N - 1)))
         cons.add(Affine(_mid_v, x, knots, steps), -vmax, vmax)
         cell_blocks = []
         if problem.cell is not None:
-            m_index = n_d + N * self.n_state + np.arange(N - 1)[None, :] * n_m + np.arange(n_m)[:, None]
-            cons.add(Affine(_mid_tie, x, (m_index, *knots), steps), 0.0, 0.0)
+            mid_index = (n_d + N * self.n_state + np.arange(N - 1)[:, None] * n_m + np.arange(n_m)[None, :])
+            cons.add(Affine(_mid_tie, x, (mid_index.T, *knots), steps), 0.0, 0.0)
             clear = clearance_terms(problem)
             n_cl = clear.size1_out(1)
-            mid_index = (n_d + N * self.n_state + np.arange(N - 1)[:, None] * n_m + np.arange(n_m)[None, :])
             for points, at, count in ((Q, y_indices(n_d, n_m, N, self.n_state), N),
                                       (M, np.hstack([mid_index, np.tile(np.arange(n_d), (N - 1, 1))]), N - 1)):
                 first = cons.size

@@ -90,6 +90,11 @@ class ConstraintList:
         self.hi.append(np.broadcast_to(np.ravel(hi, order="F"), rows))
 
     @property
+    def _starts(self) -> np.ndarray:
+        """The first row of each entry in g, then the number of rows."""
+        return np.cumsum([0, *(len(lo) for lo in self.lo)])
+
+    @property
     def size(self) -> int:
         """Rows so far: the lam_g index of the next row added."""
         return sum(len(lo) for lo in self.lo)
@@ -97,7 +102,7 @@ class ConstraintList:
     def rows(self, index: np.ndarray):
         """The rows ``index`` of g as one SX column, building only the deferred entries they fall in."""
         index = np.asarray(index, dtype=int)
-        starts = np.cumsum([0, *(len(lo) for lo in self.lo)])
+        starts = self._starts
         parts, taken = [], []
         for k, expr in enumerate(self.g):
             inside = index[(index >= starts[k]) & (index < starts[k + 1])]
@@ -113,7 +118,7 @@ class ConstraintList:
         """((rows, cols, values), others): the Jacobian of the rows ``index`` of g that lie in `Affine` entries, as
         triplets with rows numbered in g, and the rows of ``index`` that do not (ascending)."""
         index = np.asarray(index, dtype=int)
-        starts = np.cumsum([0, *(len(lo) for lo in self.lo)])
+        starts = self._starts
         wanted = np.zeros(starts[-1], dtype=bool)
         wanted[index] = True
         affine = np.zeros(starts[-1], dtype=bool)
