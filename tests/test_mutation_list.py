@@ -18,4 +18,4 @@ def test_each_mutation_applies_to_exactly_one_place(mutation):
 def test_mutation_names_are_distinct():
     names = [m.name for m in MUTATIONS]
     assert len(names) == len(set(names))
-    assert Path(__file__).parent == ROOT / "tests"
+    assert Path(__file__).resolve().parent == (ROOT / "tests").resolve()  # the list read is this checkout's
