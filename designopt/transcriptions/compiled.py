@@ -8,26 +8,28 @@ A problem's blocks the cache lacks are compiled together (`built_together`, what
 on as many of them at once as there are cores, and a library another process is already building (two workers
 starting on one shape) is waited for, not built twice.
 
-Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block the cache
-has no library of yet is compiled at -O0 where it is first needed (about 2 s for the main job's Hessian block),
-or, when its C source is large (`BACKGROUND_FROM_BYTES`: a cell's Hessian block, about 4 s of gcc), interpreted at
-once while gcc builds it in a detached background process; later builds, in any process, load that library (a
-worker's cached solver is built again once all of its blocks have theirs: `tiered_up`). Every solve that used a
-tiered block adds its seconds to the block's record in the cache, and once those reach `tier_up_after` seconds
-the same C source is compiled again at -O1 in the background (about 10 s for that block), which later builds load
-instead (`designopt cache` shows where each block stands). Every library is compiled with ``-ffp-contract=off``
-(and never with -ffast-math), so CasADi's virtual machine, -O0 and -O1 compute the same IEEE operations in the
-same order: a solve is the same to the last bit at any level, only faster compiled (the main job's default search:
-0.79x the CPU at -O1, docs/benchmarks.md), and a first build need not wait for a long compile. With
+Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block the cache has no
+library of yet is compiled at -O0 where it is first needed (about 2 s for the main job's Hessian block), or, when
+its C source is large (`BACKGROUND_FROM_BYTES`: a cell's Hessian block, about 4 s of gcc), interpreted at once while
+gcc builds it in a detached background process; later builds, in any process, load that library (a worker's cached
+solver is built again once all of its blocks have theirs: `tiered_up`). Every solve that used a tiered block adds
+its seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the same C source is
+compiled again at -O1 in the background (about 4 s for that block, its body in parts: `split_statements`), which
+later builds load instead (`designopt cache` shows where each block stands). Every library is compiled with
+``-ffp-contract=off`` (and never with -ffast-math), so CasADi's virtual machine, -O0 and -O1 compute the same IEEE
+operations in the same order: a solve is the same to the last bit at any level, only faster compiled (the main job's
+default search: 0.79x the CPU at -O1, docs/benchmarks.md), and a first build need not wait for a long compile. With
 `tier_up_after` ``never`` nothing is built in the background: a tiered block is compiled at -O0 where it is first
 needed and stays there.
 """
 
 from __future__ import annotations
 
+import functools
 import gzip
 import hashlib
 import os
+import re
 import shlex
 import subprocess
 import tempfile
@@ -46,14 +48,17 @@ GENERATOR = {"with_header": False}  # CasADi's code generator options (part of t
 FLAGS = ("-fPIC", "-shared", "-ffp-contract=off")
 # Mode ``auto``: a block evaluated at this many points or more per call is compiled at O1, any other at O0. At -O0
 # a cell's clearance Hessian block takes 3x as long per point as at -O1 (82 against 26 us, the pocket cell's PUMA)
-# and is most of an iteration on a long program, but gcc -O1 takes 35-60 s for it against 3 s: once per block and
-# machine (the cache), paid back within one solve from some 500 points (a program of 250 waypoints with a cell).
+# and is most of an iteration on a long program, but gcc -O1 takes about 8 s for it (its body in parts; 35-60 s
+# whole) against 3 s: once per block and machine (the cache), paid back within one solve from some 500 points (a
+# program of 250 waypoints with a cell).
 # Below it, ``tiered``: O0 first, O1 once the block has been solved with long enough to pay for it (module doc).
 AUTO_O1_FROM = 500
 # Seconds of solves with a tiered block after which its -O1 build starts: the solving whose -O0 penalty (about a
-# fifth of it on the main job) adds up to what gcc -O1 takes for the main job's blocks (about 10 s) -- the
-# ski-rental rule, which never costs more than twice what knowing the future would. A sweep's structure is solved
-# for about 15 s and never tiers up; a task run again and again does from its second run.
+# fifth of it on the main job) adds up to what gcc -O1 took for the main job's blocks (about 10 s, whole) -- the
+# ski-rental rule, which never costs more than twice what knowing the future would. In parts (`split_statements`)
+# gcc takes about 4 s, which would put the rule at about 25 s; kept at 60 s until a cold run and a sweep measure
+# the change. A sweep's structure is solved for about 15 s and never tiers up; a task run again and again does
+# from its second run.
 # `DESIGNOPT_TIER_UP_AFTER` (seconds, or ``never``) overrides it.
 TIER_UP_AFTER = 60.0
 # A tiered block whose C source has this many bytes or more, and no library yet, is interpreted while gcc builds its
@@ -64,6 +69,14 @@ TIER_UP_AFTER = 60.0
 # skipping only where it is long: measured, the pocket cell's cold build 5.2-6.1 -> 1.5 s, while the modular
 # experiment's many small shapes lost 1.26-1.47x with every block backgrounded (docs/decisions.md).
 BACKGROUND_FROM_BYTES = 1_500_000
+# At -O1 and -O2 a block's straight-line body is compiled in parts of this many statements (`split_statements`):
+# gcc's register allocation takes time that grows faster than the length of the function it allocates, and a
+# block is one function of up to 83,000 statements (a cell's Hessian block). In parts of 150, gcc -O1 takes 10.0 ->
+# 3.8 s of CPU for the main job's Hessian block and 39 -> 7.9 s for the pocket cell's, and a call costs about as
+# much as before (12.4 against 12.0 us a point; docs/decisions.md, Speed, 2026-12-07). At -O0 the parts are slower
+# to build and to run, so -O0 compiles the body whole.
+SPLIT_EVERY = 150
+SPLIT_FROM = 2000  # statements: a shorter body compiles in a second or two whole
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
 
 
@@ -276,14 +289,14 @@ def build_later(stem: Path, level: str, background: bool = True) -> bool:
     c_file = tmp.with_name(f"{tmp.name}.c")
     q = shlex.quote
     try:
-        c_file.write_bytes(gzip.decompress(source.read_bytes()))
+        c_file.write_text(_compiled_source(gzip.decompress(source.read_bytes()).decode(), level))
         c, out = q(str(c_file)), q(str(tmp))
         build = (f"{shlex.join(_compile_command(c_file, tmp, level))} && mv -f {out} {q(str(target))} && "
                  f"rm -f {q(str(lock))}; rm -f {out} {c}")
         # in the background the shell returns at once and the build, orphaned, outlives this process
         command = f"({build}) >/dev/null 2>&1" + (" &" if background else "")
         subprocess.run(["sh", "-c", command], check=False, stdin=subprocess.DEVNULL)
-    except (OSError, EOFError, gzip.BadGzipFile):
+    except (OSError, EOFError, gzip.BadGzipFile, UnicodeDecodeError):
         c_file.unlink(missing_ok=True)
         lock.unlink(missing_ok=True)
         return False
@@ -327,6 +340,51 @@ def _source(fn: ca.Function) -> str:
         gen = ca.CodeGenerator(f"{fn.name()}.c", GENERATOR)
         gen.add(fn)
         return Path(gen.generate(tmp + os.sep)).read_text()
+
+
+_DECLARATION = re.compile(r"  casadi_real a\d+(, a\d+)*;")
+_STATEMENT = re.compile(r"  (a\d+=|if \(res\[\d+\]!=0\) res\[\d+\]\[\d+\]=)[^{};]*;")
+_SCALAR = re.compile(r"\ba(\d+)\b")
+
+
+def split_statements(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_FROM) -> str:
+    """CasADi's C of one SX function whose body is straight-line code (scalars ``a0000, a0001, ...`` declared,
+    then one assignment or output write per line), with that body split into ``static`` parts of ``every``
+    statements called in order; the scalars become entries of one array on the stack that the parts share. The
+    same operations in the same order: the same bits (`FLAGS` has no contraction), only compiled faster at -O1
+    (`SPLIT_EVERY`). A body of fewer than ``least`` statements, or C of any other shape (more than one function, a
+    work vector, a branch), is returned as it is."""
+    head, marker, rest = source.partition("static int casadi_f0(")
+    if not marker or "casadi_f1(" in rest:
+        return source
+    signature, brace, rest = rest.partition("{\n")
+    body, end, tail = rest.partition("\n}\n")
+    if not brace or not end:
+        return source
+    lines = body.split("\n")
+    declarations = [line for line in lines if _DECLARATION.fullmatch(line)]
+    statements = lines[len(declarations):]
+    if statements[-1:] != ["  return 0;"] or len(statements) - 1 < least:
+        return source
+    statements = statements[:-1]
+    if not all(_STATEMENT.fullmatch(line) for line in statements):
+        return source
+    count = 1 + max(int(i) for line in declarations for i in _SCALAR.findall(line))
+    if count > 65536:  # more than 512 kB of stack: leave it whole
+        return source
+    parts = [statements[i:i + every] for i in range(0, len(statements), every)]
+    as_array = functools.partial(_SCALAR.sub, lambda m: f"a[{int(m.group(1))}]")  # a0012 -> a[12], not octal
+    defined = "".join(f"static __attribute__((noinline)) void casadi_f0_part{k}(const casadi_real** arg, "
+                      f"casadi_real** res, casadi_real* restrict a) {{\n" + "\n".join(map(as_array, part)) + "\n}\n"
+                      for k, part in enumerate(parts))
+    calls = "".join(f"  casadi_f0_part{k}(arg, res, a);\n" for k in range(len(parts)))
+    return (f"{head}{defined}static int casadi_f0({signature}{{\n  casadi_real a[{count}];\n{calls}  return 0;\n}}\n"
+            f"{tail}")
+
+
+def _compiled_source(source: str, level: str) -> str:
+    """The C that gcc compiles at ``level``: the block's body in parts above -O0 (`split_statements`)."""
+    return source if level == "O0" else split_statements(source)
 
 
 def _keep_source(stem: Path, source: str) -> None:
@@ -379,7 +437,7 @@ def _run_builds(mine: list[tuple[Path, str]], running: list) -> None:
                 if not done:
                     time.sleep(0.005)
             try:
-                c_file.write_text(source)
+                c_file.write_text(_compiled_source(source, library.name.split(".")[-2]))
                 process = subprocess.Popen(_compile_command(c_file, tmp_lib, library.name.split(".")[-2]),
                                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                            stderr=subprocess.DEVNULL)
@@ -412,7 +470,7 @@ def _lock_of(library: Path) -> Path:
 def _build(source: str, library: Path, mode: str) -> None:
     with tempfile.TemporaryDirectory(dir=library.parent) as tmp:
         c_file = Path(tmp) / "fn.c"
-        c_file.write_text(source)
+        c_file.write_text(_compiled_source(source, mode))
         tmp_lib = Path(tmp) / library.name
         subprocess.run(_compile_command(c_file, tmp_lib, mode), check=True, capture_output=True)
         os.replace(tmp_lib, library)

@@ -1,0 +1,88 @@
+"""A long block's body compiled in parts (`designopt.transcriptions.compiled.split_statements`): gcc -O1 allocates
+registers in time that grows faster than a function's length, so above -O0 the straight-line body CasADi generates
+is cut into parts that share its scalars through one array. The parts run the same IEEE operations in the same
+order, so the library must give the same bits as CasADi's own virtual machine (the independent truth here), and it
+must really be the split C that gcc built (a library that fails to build falls back to the interpreted function
+silently, which would make a bit test pass for nothing)."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+
+import casadi as ca
+import numpy as np
+
+from designopt.transcriptions import compiled as compiled_module
+from designopt.transcriptions.compiled import compiled, split_statements
+
+
+def _long_function(operations: int) -> ca.Function:
+    """(x[4], s) -> (y[3], z): a straight line of about ``operations`` SX operations mixing every kind CasADi writes
+    as one C statement (arithmetic, sin/cos/exp/sqrt, fmin/fmax, fabs, sign), with two outputs written at different
+    points of the body."""
+    x, s = ca.SX.sym("x", 4), ca.SX.sym("s")
+    values = [x[0], x[1], x[2], x[3], s]
+    while len(values) < operations // 3:
+        a, b, c = values[-1], values[-3], values[-5]
+        values.append(ca.sin(a) * b + ca.fmax(c, -0.5) / (1 + ca.fabs(a)))
+        values.append(ca.sqrt(1 + b * b) - ca.exp(-ca.fmin(c * c, 4)) * ca.sign(a))
+    first = ca.vertcat(values[40], values[len(values) // 2], values[-7])
+    return ca.Function("longblock", [x, s], [first, values[-1] * values[-2]])
+
+
+def _random_args(fn: ca.Function, rng) -> list[np.ndarray]:
+    return [rng.normal(size=fn.sparsity_in(i).shape) for i in range(fn.n_in())]
+
+
+def test_a_long_body_compiled_in_parts_gives_the_interpreted_bits(tmp_path, monkeypatch):
+    """At -O1 a body above `SPLIT_FROM` statements is built in parts (the library's symbols show them), at -O0
+    whole, and both libraries compute exactly what the interpreted function does at 300 random points."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    fn = _long_function(3 * compiled_module.SPLIT_FROM)
+    source = compiled_module._source(fn)
+    split = split_statements(source)
+    parts = len(re.findall(r"static __attribute__\(\(noinline\)\) void casadi_f0_part\d+\(", split))
+    statements = len(re.findall(r"^  (a\d+=|if \(res)", source, re.M))
+    assert statements > compiled_module.SPLIT_FROM
+    assert parts == -(-statements // compiled_module.SPLIT_EVERY)
+    o1, o0 = compiled(fn, "O1"), compiled(fn, "O0")
+    assert {p.name.split(".")[1] for p in tmp_path.glob("longblock_*.so")} == {"O0", "O1"}  # both really built
+    assert o1.class_name() == o0.class_name() == "External"  # not the interpreted stand-in
+    symbols = {level: subprocess.run(["nm", str(next(tmp_path.glob(f"longblock_*.{level}.so")))], check=True,
+                                     capture_output=True, text=True).stdout for level in ("O0", "O1")}
+    assert symbols["O1"].count("casadi_f0_part") == parts and "casadi_f0_part" not in symbols["O0"]
+    rng = np.random.default_rng(11)
+    for _ in range(300):
+        args = _random_args(fn, rng)
+        truth = [np.array(v) for v in fn(*args)]
+        for level in (o1, o0):
+            got = [np.array(v) for v in level(*args)]
+            assert all(np.array_equal(t, g, equal_nan=True) for t, g in zip(truth, got, strict=True))
+
+
+def test_split_parts_cover_every_statement_once_in_order():
+    """The parts hold the body's statements in their order, every scalar a0012 written a[12] (not an octal
+    literal), and the function keeps its signature and its return."""
+    fn = _long_function(900)
+    source = compiled_module._source(fn)
+    split = split_statements(source, every=7, least=10)
+    body = re.findall(r"^  (?:a\d+=|if \(res).*;$", source, re.M)
+    moved = re.findall(r"^  (?:a\[\d+\]=|if \(res).*;$", split, re.M)
+    assert [re.sub(r"\ba(\d+)\b", lambda m: f"a[{int(m.group(1))}]", line) for line in body] == moved
+    assert not re.search(r"a\[0\d", split)
+    assert "static int casadi_f0(const casadi_real** arg, casadi_real** res" in split
+    assert split.count("  return 0;") == source.count("  return 0;")
+
+
+def test_sources_of_other_shapes_are_left_whole():
+    """A short body, a body with a branch, a source of two functions and C that is not CasADi's come back as they
+    were."""
+    fn = _long_function(900)
+    source = compiled_module._source(fn)
+    assert split_statements(source) == source  # fewer than SPLIT_FROM statements
+    branched = source.replace("  return 0;", "  if (arg[0]) { a0001=1.0; }\n  return 0;", 1)
+    assert split_statements(branched, every=7, least=10) == branched
+    two = source + source.replace("casadi_f0", "casadi_f1")
+    assert split_statements(two, every=7, least=10) == two
+    assert split_statements("int main(void) { return 0; }\n", every=7, least=1) == "int main(void) { return 0; }\n"
