@@ -62,15 +62,30 @@ def test_a_long_body_compiled_in_parts_gives_the_interpreted_bits(tmp_path, monk
 
 
 def test_split_parts_cover_every_statement_once_in_order():
-    """The parts hold the body's statements in their order, every scalar a0012 written a[12] (not an octal
-    literal), and the function keeps its signature and its return."""
+    """The parts hold the body's statements in their order, each scalar a0012 written a[12] (not an octal literal)
+    or as the part's local l12; a value read by a later part goes through the array, one read only within its part
+    stays local; the function keeps its signature and its return."""
     fn = _long_function(900)
     source = compiled_module._source(fn)
     split = split_statements(source, every=7, least=10)
     body = re.findall(r"^  (?:a\d+=|if \(res).*;$", source, re.M)
-    moved = re.findall(r"^  (?:a\[\d+\]=|if \(res).*;$", split, re.M)
-    assert [re.sub(r"\ba(\d+)\b", lambda m: f"a[{int(m.group(1))}]", line) for line in body] == moved
+    moved = re.findall(r"^  (?:a\[\d+\]=|l\d+=|if \(res).*;$", split, re.M)
+    plain = [re.sub(r"\ba\[(\d+)\]|\bl(\d+)\b", lambda m: f"a{int(m.group(1) or m.group(2))}", line)
+             for line in moved]
+    assert plain == [re.sub(r"\ba(\d+)\b", lambda m: f"a{int(m.group(1))}", line) for line in body]
     assert not re.search(r"a\[0\d", split)
+    parts = re.findall(r"void casadi_f0_part\d+\([^)]*\) \{\n(.*?)\n\}\n", split, re.S)
+    assert len(parts) == -(-len(body) // 7)
+    for k, part in enumerate(parts):
+        defined = set()
+        for line in part.split("\n")[1:]:  # after the part's declaration
+            target, _, expression = line.partition("=") if not line.startswith("  if") else ("", "", line)
+            assert set(re.findall(r"\bl\d+\b", expression)) <= defined  # a local is read only after its part set it
+            defined |= set(re.findall(r"\bl\d+\b", target))
+        later = "\n".join(parts[k + 1:])
+        for stored in set(re.findall(r"\ba\[(\d+)\]=", part)):
+            assert f"a[{stored}]" in later  # an array entry written for a later part
+    assert any(re.search(r"\bl\d+=", part) for part in parts) and any("a[" in part for part in parts)
     assert "static int casadi_f0(const casadi_real** arg, casadi_real** res" in split
     assert split.count("  return 0;") == source.count("  return 0;")
 

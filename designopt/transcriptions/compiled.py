@@ -25,7 +25,6 @@ needed and stays there.
 
 from __future__ import annotations
 
-import functools
 import gzip
 import hashlib
 import os
@@ -343,17 +342,19 @@ def _source(fn: ca.Function) -> str:
 
 
 _DECLARATION = re.compile(r"  casadi_real a\d+(, a\d+)*;")
-_STATEMENT = re.compile(r"  (a\d+=|if \(res\[\d+\]!=0\) res\[\d+\]\[\d+\]=)[^{};]*;")
+_ASSIGNMENT = re.compile(r"  a(\d+)=([^{};]*);")
+_OUTPUT = re.compile(r"  if \(res\[\d+\]!=0\) res\[\d+\]\[\d+\]=[^{};]*;")
 _SCALAR = re.compile(r"\ba(\d+)\b")
 
 
 def split_statements(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_FROM) -> str:
     """CasADi's C of one SX function whose body is straight-line code (scalars ``a0000, a0001, ...`` declared,
     then one assignment or output write per line), with that body split into ``static`` parts of ``every``
-    statements called in order; the scalars become entries of one array on the stack that the parts share. The
-    same operations in the same order: the same bits (`FLAGS` has no contraction), only compiled faster at -O1
-    (`SPLIT_EVERY`). A body of fewer than ``least`` statements, or C of any other shape (more than one function, a
-    work vector, a branch), is returned as it is."""
+    statements called in order. A value used only within its part stays a local of the part (a register, as
+    before); one used by a later part is written to an array on the stack that the parts share, and read from it
+    there. The same operations in the same order: the same bits (`FLAGS` has no contraction), only compiled
+    faster at -O1 (`SPLIT_EVERY`). A body of fewer than ``least`` statements, or C of any other shape (more than
+    one function, a work vector, a branch), is returned as it is."""
     head, marker, rest = source.partition("static int casadi_f0(")
     if not marker or "casadi_f1(" in rest:
         return source
@@ -367,16 +368,48 @@ def split_statements(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_F
     if statements[-1:] != ["  return 0;"] or len(statements) - 1 < least:
         return source
     statements = statements[:-1]
-    if not all(_STATEMENT.fullmatch(line) for line in statements):
-        return source
+    # each statement as (the scalar it assigns or None for an output write, the text after "=" or the line)
+    parsed = []
+    for line in statements:
+        assignment = _ASSIGNMENT.fullmatch(line)
+        if assignment:
+            parsed.append((int(assignment.group(1)), assignment.group(2)))
+        elif _OUTPUT.fullmatch(line):
+            parsed.append((None, line))
+        else:
+            return source
     count = 1 + max(int(i) for line in declarations for i in _SCALAR.findall(line))
     if count > 65536:  # more than 512 kB of stack: leave it whole
         return source
-    parts = [statements[i:i + every] for i in range(0, len(statements), every)]
-    as_array = functools.partial(_SCALAR.sub, lambda m: f"a[{int(m.group(1))}]")  # a0012 -> a[12], not octal
+    last_use, current = {}, {}  # the statement that last reads each assignment's value; each scalar's assignment
+    for i, (scalar, text) in enumerate(parsed):
+        for used in _SCALAR.findall(text):
+            if int(used) not in current:
+                return source  # read before it is written: not the straight-line code expected
+            last_use[current[int(used)]] = i
+        if scalar is not None:
+            current[scalar] = i
+    parts = []
+    for begin in range(0, len(parsed), every):
+        stop = min(begin + every, len(parsed))
+        name, local, text = {}, set(), []  # within the part: the name of each scalar's value
+        for i in range(begin, stop):
+            scalar, expression = parsed[i]
+            expression = _SCALAR.sub(lambda m, name=name: name.get(int(m.group(1)), f"a[{int(m.group(1))}]"),
+                                     expression)
+            if scalar is None:
+                text.append(expression)
+                continue
+            if last_use.get(i, -1) >= stop:  # read by a later part
+                name[scalar] = f"a[{scalar}]"
+            else:
+                name[scalar] = f"l{scalar}"
+                local.add(scalar)
+            text.append(f"  {name[scalar]}={expression};")
+        declared = f"  casadi_real {', '.join(f'l{v}' for v in sorted(local))};\n" if local else ""
+        parts.append(declared + "\n".join(text))
     defined = "".join(f"static __attribute__((noinline)) void casadi_f0_part{k}(const casadi_real** arg, "
-                      f"casadi_real** res, casadi_real* restrict a) {{\n" + "\n".join(map(as_array, part)) + "\n}\n"
-                      for k, part in enumerate(parts))
+                      f"casadi_real** res, casadi_real* restrict a) {{\n{part}\n}}\n" for k, part in enumerate(parts))
     calls = "".join(f"  casadi_f0_part{k}(arg, res, a);\n" for k in range(len(parts)))
     return (f"{head}{defined}static int casadi_f0({signature}{{\n  casadi_real a[{count}];\n{calls}  return 0;\n}}\n"
             f"{tail}")
