@@ -1,9 +1,9 @@
 """A long block's body compiled in parts (`designopt.transcriptions.compiled.split_statements`): gcc -O1 allocates
-registers in time that grows faster than a function's length, so above -O0 the straight-line body CasADi generates
-is cut into parts that share its scalars through one array. The parts run the same IEEE operations in the same
-order, so the library must give the same bits as CasADi's own virtual machine (the independent truth here), and it
-must really be the split C that gcc built (a library that fails to build falls back to the interpreted function
-silently, which would make a bit test pass for nothing)."""
+registers in time that grows faster than a function's length, so an -O1 build that a solve waits for cuts the
+straight-line body CasADi generates into parts that share the values crossing them through one array. The parts run
+the same IEEE operations in the same order, so the library must give the same bits as CasADi's own virtual machine
+(the independent truth here), and it must really be the split C that gcc built (a library that fails to build falls
+back to the interpreted function silently, which would make a bit test pass for nothing)."""
 
 from __future__ import annotations
 
@@ -101,3 +101,26 @@ def test_sources_of_other_shapes_are_left_whole():
     two = source + source.replace("casadi_f0", "casadi_f1")
     assert split_statements(two, every=7, least=10) == two
     assert split_statements("int main(void) { return 0; }\n", every=7, least=1) == "int main(void) { return 0; }\n"
+
+
+def test_the_background_tier_up_compiles_the_body_whole(tmp_path, monkeypatch):
+    """A tier-up, which no solve waits for, builds its -O1 library from the whole body (the faster library), and it
+    gives the same bits as the interpreted function."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    fn = _long_function(3 * compiled_module.SPLIT_FROM)
+    used = []
+    compiled(fn, "tiered", used)
+    stem = used[0].with_name(used[0].name.split(".", 1)[0])
+    assert compiled_module.tier_up(stem, background=False)
+    library = compiled_module.library_at(stem, "O1")
+    assert library.exists()
+    assert "casadi_f0_part" not in subprocess.run(["nm", str(library)], check=True, capture_output=True,
+                                                  text=True).stdout
+    loaded = compiled(fn, "tiered")
+    assert loaded.class_name() == "External"
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        args = _random_args(fn, rng)
+        assert all(np.array_equal(np.array(t), np.array(g), equal_nan=True)
+                   for t, g in zip(fn(*args), loaded(*args), strict=True))

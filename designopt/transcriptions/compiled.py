@@ -14,7 +14,7 @@ its C source is large (`BACKGROUND_FROM_BYTES`: a cell's Hessian block, about 4 
 gcc builds it in a detached background process; later builds, in any process, load that library (a worker's cached
 solver is built again once all of its blocks have theirs: `tiered_up`). Every solve that used a tiered block adds
 its seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the same C source is
-compiled again at -O1 in the background (about 4 s for that block, its body in parts: `split_statements`), which
+compiled again at -O1 in the background (about 10 s for that block), which
 later builds load instead (`designopt cache` shows where each block stands). Every library is compiled with
 ``-ffp-contract=off`` (and never with -ffast-math), so CasADi's virtual machine, -O0 and -O1 compute the same IEEE
 operations in the same order: a solve is the same to the last bit at any level, only faster compiled (the main job's
@@ -53,11 +53,9 @@ FLAGS = ("-fPIC", "-shared", "-ffp-contract=off")
 # Below it, ``tiered``: O0 first, O1 once the block has been solved with long enough to pay for it (module doc).
 AUTO_O1_FROM = 500
 # Seconds of solves with a tiered block after which its -O1 build starts: the solving whose -O0 penalty (about a
-# fifth of it on the main job) adds up to what gcc -O1 took for the main job's blocks (about 10 s, whole) -- the
-# ski-rental rule, which never costs more than twice what knowing the future would. In parts (`split_statements`)
-# gcc takes about 4 s, which would put the rule at about 25 s; kept at 60 s until a cold run and a sweep measure
-# the change. A sweep's structure is solved for about 15 s and never tiers up; a task run again and again does
-# from its second run.
+# fifth of it on the main job) adds up to what gcc -O1 takes for the main job's blocks (about 10 s) -- the
+# ski-rental rule, which never costs more than twice what knowing the future would. A sweep's structure is solved
+# for about 15 s and never tiers up; a task run again and again does from its second run.
 # `DESIGNOPT_TIER_UP_AFTER` (seconds, or ``never``) overrides it.
 TIER_UP_AFTER = 60.0
 # A tiered block whose C source has this many bytes or more, and no library yet, is interpreted while gcc builds its
@@ -68,12 +66,13 @@ TIER_UP_AFTER = 60.0
 # skipping only where it is long: measured, the pocket cell's cold build 5.2-6.1 -> 1.5 s, while the modular
 # experiment's many small shapes lost 1.26-1.47x with every block backgrounded (docs/decisions.md).
 BACKGROUND_FROM_BYTES = 1_500_000
-# At -O1 and -O2 a block's straight-line body is compiled in parts of this many statements (`split_statements`):
-# gcc's register allocation takes time that grows faster than the length of the function it allocates, and a
-# block is one function of up to 83,000 statements (a cell's Hessian block). In parts of 150, gcc -O1 takes 10.0 ->
-# 3.8 s of CPU for the main job's Hessian block and 39 -> 7.9 s for the pocket cell's, and a call costs about as
-# much as before (12.4 against 12.0 us a point; docs/decisions.md, Speed, 2026-12-07). At -O0 the parts are slower
-# to build and to run, so -O0 compiles the body whole.
+# A build at -O1 or -O2 that a solve waits for compiles a block's straight-line body in parts of this many
+# statements (`split_statements`): gcc's register allocation takes time that grows faster than the length of the
+# function it allocates, and a block is one function of up to 83,000 statements (a cell's Hessian block). In
+# parts, gcc -O1 takes 2.7 s of CPU instead of 10 s for the main job's Hessian block and 5.9 s instead of 39 s for
+# a cell's; a call of the main job's block costs 1.04x (the exploration's iteration 1.03x), the cell's 0.96x
+# (docs/decisions.md, Speed, 2026-12-07). A background build (the tier-up, `build_later`), which no solve waits
+# for, compiles the body whole, and so does -O0 (in parts slower to build and to run).
 SPLIT_EVERY = 150
 SPLIT_FROM = 2000  # statements: a shorter body compiles in a second or two whole
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
@@ -288,14 +287,14 @@ def build_later(stem: Path, level: str, background: bool = True) -> bool:
     c_file = tmp.with_name(f"{tmp.name}.c")
     q = shlex.quote
     try:
-        c_file.write_text(_compiled_source(gzip.decompress(source.read_bytes()).decode(), level))
+        c_file.write_bytes(gzip.decompress(source.read_bytes()))
         c, out = q(str(c_file)), q(str(tmp))
         build = (f"{shlex.join(_compile_command(c_file, tmp, level))} && mv -f {out} {q(str(target))} && "
                  f"rm -f {q(str(lock))}; rm -f {out} {c}")
         # in the background the shell returns at once and the build, orphaned, outlives this process
         command = f"({build}) >/dev/null 2>&1" + (" &" if background else "")
         subprocess.run(["sh", "-c", command], check=False, stdin=subprocess.DEVNULL)
-    except (OSError, EOFError, gzip.BadGzipFile, UnicodeDecodeError):
+    except (OSError, EOFError, gzip.BadGzipFile):
         c_file.unlink(missing_ok=True)
         lock.unlink(missing_ok=True)
         return False
@@ -416,7 +415,8 @@ def split_statements(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_F
 
 
 def _compiled_source(source: str, level: str) -> str:
-    """The C that gcc compiles at ``level``: the block's body in parts above -O0 (`split_statements`)."""
+    """The C that gcc compiles at ``level`` for a build a solve waits for: the block's body in parts above -O0
+    (`split_statements`; `SPLIT_EVERY`)."""
     return source if level == "O0" else split_statements(source)
 
 
