@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 
 from designopt.transcriptions import compiled as compiled_module
-from designopt.transcriptions.compiled import compiled, split_statements
+from designopt.transcriptions.compiled import built_together, compiled, split_statements
 
 
 def _long_function(operations: int) -> ca.Function:
@@ -23,8 +23,8 @@ def _long_function(operations: int) -> ca.Function:
     points of the body."""
     x, s = ca.SX.sym("x", 4), ca.SX.sym("s")
     values = [x[0], x[1], x[2], x[3], s]
-    while len(values) < operations // 3:
-        a, b, c = values[-1], values[-3], values[-5]
+    while len(values) < operations // 3:  # values reach 40 back: dozens live at once, CasADi's names padded (a08)
+        a, b, c = values[-1], values[-3], values[-min(len(values), 40)]
         values.append(ca.sin(a) * b + ca.fmax(c, -0.5) / (1 + ca.fabs(a)))
         values.append(ca.sqrt(1 + b * b) - ca.exp(-ca.fmin(c * c, 4)) * ca.sign(a))
     first = ca.vertcat(values[40], values[len(values) // 2], values[-7])
@@ -93,9 +93,10 @@ def test_split_parts_cover_every_statement_once_in_order():
 def test_sources_of_other_shapes_are_left_whole():
     """A short body, a body with a branch, a source of two functions and C that is not CasADi's come back as they
     were."""
-    fn = _long_function(900)
+    fn = _long_function(300)
     source = compiled_module._source(fn)
-    assert split_statements(source) == source  # fewer than SPLIT_FROM statements
+    assert len(re.findall(r"^  a\d+=", source, re.M)) < compiled_module.SPLIT_FROM
+    assert split_statements(source) == source
     branched = source.replace("  return 0;", "  if (arg[0]) { a0001=1.0; }\n  return 0;", 1)
     assert split_statements(branched, every=7, least=10) == branched
     two = source + source.replace("casadi_f0", "casadi_f1")
@@ -124,3 +125,19 @@ def test_the_background_tier_up_compiles_the_body_whole(tmp_path, monkeypatch):
         args = _random_args(fn, rng)
         assert all(np.array_equal(np.array(t), np.array(g), equal_nan=True)
                    for t, g in zip(fn(*args), loaded(*args), strict=True))
+
+
+def test_a_problems_blocks_built_together_compile_in_parts(tmp_path, monkeypatch):
+    """The blocks an NLP's build notes and compiles together on leaving `built_together` (gcc in parallel) are
+    split like one built alone, and load as the same bits."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    fn = _long_function(3 * compiled_module.SPLIT_FROM)
+    with built_together() as batch:
+        stand_in = compiled(fn, "O1")
+    assert batch.here and stand_in.class_name() != "External"
+    library = next(tmp_path.glob("longblock_*.O1.so"))
+    assert "casadi_f0_part" in subprocess.run(["nm", str(library)], check=True, capture_output=True, text=True).stdout
+    loaded = compiled(fn, "O1")
+    assert loaded.class_name() == "External"
+    args = _random_args(fn, np.random.default_rng(2))
+    assert all(np.array_equal(np.array(t), np.array(g)) for t, g in zip(fn(*args), loaded(*args), strict=True))
