@@ -516,11 +516,14 @@ PRESETS: dict[str, Search] = {
     # joints gets more starts and screens (`small_problem_starts`, `screening`); below 5 joints perturbed by 0.6 and
     # twice its share of the starts (`small_arm_starts`). Each setting was judged on fresh seeds against the preset
     # before it (whole sweeps; the small arms' doubled starts on 20 seeds of each small reference structure searched
-    # alone): docs/benchmarks.md "Sweep", docs/decisions.md.
+    # alone): docs/benchmarks.md "Sweep", docs/decisions.md. Its blocks compiled at -O1 where first needed, in parts
+    # (`designopt.transcriptions.compiled.split_statements`), not tiered: a structure is solved for about 20 s, too
+    # short to tier up, and its solves at -O1 take 0.85x the CPU of -O0's for about 1.3 s more gcc a structure
+    # (the 5-joint structures 0.954x the wall, every solve the same; docs/decisions.md, Speed, 2026-12-07).
     "quick": Search(starts=40, rebranch=0, screen=12, screen_waypoints=20, refine=4, reflect=3, small_problem_starts=4,
                     explore_linear_solver="ldl", screen_linear_solver=("ldl", "mumps"), small_arm_screens_once=True,
                     small_arm_perturbation=0.6, small_arm_starts=2,
-                    profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN)),
+                    profile=SolverProfile(max_iter=600, time_limit=60.0, options=DEGENERATE_JACOBIAN, compile="O1")),
     "default": DEFAULT,
     # a best design worth three times the wait: the default made three times independently, the best of the three
     # (`Search.draws`); what it reaches is estimated from the default's evaluation runs taken three at a time
