@@ -7,6 +7,8 @@ function as the independent truth."""
 from __future__ import annotations
 
 import os
+import subprocess
+import sys
 import time
 
 import casadi as ca
@@ -491,3 +493,21 @@ def test_the_cache_command_counts_levels_and_records_and_clears(tmp_path, monkey
     assert (tmp_path / "ldl_0123456789abcdef0123.so").exists()
     cleared = runner.invoke(app, ["cache", "--clear"])
     assert cleared.exit_code == 0 and "removed" in cleared.output and not list(tmp_path.iterdir())
+
+
+def test_a_build_lock_of_a_process_that_died_is_taken_over(tmp_path, monkeypatch):
+    """A foreground build's lock names its process: one left by a process that died mid-build (a sweep killed during
+    gcc) is taken over and the library built, not waited for; a live process's lock, and a background build's lock
+    (no process named) younger than `STALE_LOCK_S`, are waited for and left alone."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    x = ca.SX.sym("x", 2)
+    source = compiled_module._source(ca.Function("blk9", [x], [ca.sin(x[0]) * x[1]]))
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    cases = {"dead": str(dead.pid), "alive": str(os.getpid()), "background": ""}
+    for name, text in cases.items():
+        library = tmp_path / f"blk9_{name}.O0.so"
+        library.with_name(f"{library.name}.lock").write_text(text)
+        compiled_module._build_all([(source, library)], wait_s=0.5)
+        assert library.exists() == (name == "dead"), name
+        assert library.with_name(f"{library.name}.lock").exists() == (name != "dead"), name

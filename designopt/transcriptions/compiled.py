@@ -302,20 +302,43 @@ def build_later(stem: Path, level: str, background: bool = True) -> bool:
     return True
 
 
-def _take(lock: Path) -> bool:
-    """Create ``lock`` if no other process holds it (a lock older than `STALE_LOCK_S` is taken over)."""
+def _take(lock: Path, holder: bool = False) -> bool:
+    """Create ``lock`` if no other process holds it. With ``holder``, this process's id is written into it: the
+    process itself builds and releases it (`_build_all`), so a lock whose process is gone (a sweep killed during a
+    build) is taken over at once; a lock without a process id (a background build, whose shell outlives the process
+    that took it) only once it is older than `STALE_LOCK_S`."""
     for _ in range(2):
         try:
-            os.close(os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY))
+            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+            if holder:
+                os.write(fd, str(os.getpid()).encode())
+            os.close(fd)
             return True
         except FileExistsError:
             try:
-                if time.time() - lock.stat().st_mtime < STALE_LOCK_S:
+                if _held(lock):
                     return False
                 lock.unlink()
             except FileNotFoundError:
                 pass
     return False
+
+
+def _held(lock: Path) -> bool:
+    """Whether ``lock`` exists and its build may still be under way: its process (when it names one) is alive, or
+    (when it names none) it is younger than `STALE_LOCK_S`."""
+    try:
+        text = lock.read_text().strip()
+        if text.isdigit():
+            os.kill(int(text), 0)  # raises if no such process
+            return True
+        return time.time() - lock.stat().st_mtime < STALE_LOCK_S
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # a process of another user holds it
+        return True
+    except FileNotFoundError:
+        return False
 
 
 def _is_number(text: str) -> bool:
@@ -435,7 +458,7 @@ def _build_all(builds: list[tuple[str, Path]], wait_s: float = 120.0) -> None:
     (the block is then built, or interpreted, where it is next met)."""
     missing = {library: source for source, library in builds if not library.exists()}  # each library once
     pending = sorted(missing.items(), key=lambda b: -len(b[1]))
-    mine = [(library, source) for library, source in pending if _take(_lock_of(library))]
+    mine = [(library, source) for library, source in pending if _take(_lock_of(library), holder=True)]
     theirs = [library for library in missing if library not in dict(mine)]
     running: list[tuple[subprocess.Popen | None, Path, Path, str]] = []
     try:
@@ -449,7 +472,7 @@ def _build_all(builds: list[tuple[str, Path]], wait_s: float = 120.0) -> None:
         raise
     deadline = time.time() + wait_s
     while theirs and time.time() < deadline:
-        theirs = [lib for lib in theirs if not lib.exists() and _lock_of(lib).exists()]
+        theirs = [lib for lib in theirs if not lib.exists() and _held(_lock_of(lib))]
         if theirs:
             time.sleep(0.01)
 
