@@ -91,14 +91,16 @@ def test_split_parts_cover_every_statement_once_in_order():
 
 
 def test_sources_of_other_shapes_are_left_whole():
-    """A short body, a body with a branch, a source of two functions and C that is not CasADi's come back as they
-    were."""
+    """A short body, a body with a branch, one that reads the work vector, a source of two functions and C that is
+    not CasADi's come back as they were."""
     fn = _long_function(300)
     source = compiled_module._source(fn)
     assert len(re.findall(r"^  a\d+=", source, re.M)) < compiled_module.SPLIT_FROM
     assert split_statements(source) == source
     branched = source.replace("  return 0;", "  if (arg[0]) { a0001=1.0; }\n  return 0;", 1)
     assert split_statements(branched, every=7, least=10) == branched
+    worked = source.replace("  return 0;", "  a0001=w[0];\n  return 0;", 1)
+    assert split_statements(worked, every=7, least=10) == worked
     two = source + source.replace("casadi_f0", "casadi_f1")
     assert split_statements(two, every=7, least=10) == two
     assert split_statements("int main(void) { return 0; }\n", every=7, least=1) == "int main(void) { return 0; }\n"

@@ -368,6 +368,7 @@ _DECLARATION = re.compile(r"  casadi_real a\d+(, a\d+)*;")
 _ASSIGNMENT = re.compile(r"  a(\d+)=([^{};]*);")
 _OUTPUT = re.compile(r"  if \(res\[\d+\]!=0\) res\[\d+\]\[\d+\]=[^{};]*;")
 _SCALAR = re.compile(r"\ba(\d+)\b")
+_WORK = re.compile(r"\b(i?w|mem)\b")  # casadi_f0's other arguments: a body that uses them stays whole
 
 
 def split_statements(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_FROM) -> str:
@@ -388,13 +389,15 @@ def split_statements(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_F
     lines = body.split("\n")
     declarations = [line for line in lines if _DECLARATION.fullmatch(line)]
     statements = lines[len(declarations):]
-    if statements[-1:] != ["  return 0;"] or len(statements) - 1 < least:
+    if not declarations or statements[-1:] != ["  return 0;"] or len(statements) - 1 < least:
         return source
     statements = statements[:-1]
     # each statement as (the scalar it assigns or None for an output write, the text after "=" or the line)
     parsed = []
     for line in statements:
         assignment = _ASSIGNMENT.fullmatch(line)
+        if _WORK.search(line):  # the parts get arg, res and the shared array only
+            return source
         if assignment:
             parsed.append((int(assignment.group(1)), assignment.group(2)))
         elif _OUTPUT.fullmatch(line):
@@ -486,6 +489,7 @@ def _run_builds(mine: list[tuple[Path, str]], running: list) -> None:
     with tempfile.TemporaryDirectory(dir=mine[0][0].parent) as tmp:
         for k, (library, source) in enumerate(mine):
             c_file, tmp_lib = Path(tmp) / f"fn{k}.c", Path(tmp) / f"{k}_{library.name}"
+            level = library.name.split(".")[-2]  # <name>_<key>.<level>.so
             while len(running) >= cores:  # wait for whichever finishes first
                 done = [b for b in running if b[0] is None or b[0].poll() is not None]
                 for b in done:
@@ -494,8 +498,8 @@ def _run_builds(mine: list[tuple[Path, str]], running: list) -> None:
                 if not done:
                     time.sleep(0.005)
             try:
-                c_file.write_text(_compiled_source(source, library.name.split(".")[-2]))
-                process = subprocess.Popen(_compile_command(c_file, tmp_lib, library.name.split(".")[-2]),
+                c_file.write_text(_compiled_source(source, level))
+                process = subprocess.Popen(_compile_command(c_file, tmp_lib, level),
                                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                                            stderr=subprocess.DEVNULL)
             except OSError:
