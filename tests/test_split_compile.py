@@ -17,7 +17,7 @@ from designopt.transcriptions import compiled as compiled_module
 from designopt.transcriptions.compiled import built_together, compiled, split_statements
 
 
-def _long_function(operations: int) -> ca.Function:
+def _long_function(operations: int, name: str = "longblock") -> ca.Function:
     """(x[4], s) -> (y[3], z): a straight line of about ``operations`` SX operations mixing every kind CasADi writes
     as one C statement (arithmetic, sin/cos/exp/sqrt, fmin/fmax, fabs, sign), with two outputs written at different
     points of the body."""
@@ -28,7 +28,7 @@ def _long_function(operations: int) -> ca.Function:
         values.append(ca.sin(a) * b + ca.fmax(c, -0.5) / (1 + ca.fabs(a)))
         values.append(ca.sqrt(1 + b * b) - ca.exp(-ca.fmin(c * c, 4)) * ca.sign(a))
     first = ca.vertcat(values[40], values[len(values) // 2], values[-7])
-    return ca.Function("longblock", [x, s], [first, values[-1] * values[-2]])
+    return ca.Function(name, [x, s], [first, values[-1] * values[-2]])
 
 
 def _random_args(fn: ca.Function, rng) -> list[np.ndarray]:
@@ -143,3 +143,97 @@ def test_a_problems_blocks_built_together_compile_in_parts(tmp_path, monkeypatch
     assert loaded.class_name() == "External"
     args = _random_args(fn, np.random.default_rng(2))
     assert all(np.array_equal(np.array(t), np.array(g)) for t, g in zip(fn(*args), loaded(*args), strict=True))
+
+
+def test_a_long_body_built_from_several_files_gives_the_interpreted_bits(tmp_path, monkeypatch):
+    """With a unit of 1,500 statements a body of about 6,000 is built from a file of the entry point and several
+    files of parts (`translation_units`), each part defined once, all linked into one library: its symbols show the
+    parts (local to the library), and it computes exactly what the interpreted function does at 300 random points."""
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled_module, "UNIT_STATEMENTS", 1500)
+    fn = _long_function(3 * compiled_module.SPLIT_FROM)
+    source = compiled_module._source(fn)
+    units = compiled_module.translation_units(source)
+    parts = len(re.findall(r"void casadi_f0_part\d+\(", split_statements(source)))
+    group = 1500 // compiled_module.SPLIT_EVERY
+    assert len(units) == 1 + -(-parts // group) >= 4
+    defined = [re.findall(r"^__attribute__\(\(noinline, visibility\(\"hidden\"\)\)\) void (casadi_f0_part\d+)\(.*\{$",
+                          unit, re.M) for unit in units]
+    assert defined[0] == [] and sorted(sum(defined, []), key=lambda n: int(n[14:])) == [
+        f"casadi_f0_part{k}" for k in range(parts)]
+    assert all(len(names) <= group for names in defined)
+    assert units[0].count(");\n") >= parts  # the entry point's file declares every part
+    assert all("casadi_version" not in unit and "static casadi_real casadi_sq(" in unit for unit in units[1:])
+    library = compiled(fn, "O1")
+    assert library.class_name() == "External"  # built, not the interpreted stand-in
+    symbols = subprocess.run(["nm", str(next(tmp_path.glob("longblock_*.O1.so")))], check=True, capture_output=True,
+                             text=True).stdout
+    local = re.findall(r" t casadi_f0_part\d+$", symbols, re.M)
+    assert len(local) == parts and " T casadi_f0_part" not in symbols
+    rng = np.random.default_rng(12)
+    for _ in range(300):
+        args = _random_args(fn, rng)
+        truth = [np.array(v) for v in fn(*args)]
+        got = [np.array(v) for v in library(*args)]
+        assert all(np.array_equal(t, g, equal_nan=True) for t, g in zip(truth, got, strict=True))
+
+
+def _logging_compiler(tmp_path, fail: str = "") -> str:
+    """A C compiler that runs gcc, logging each run's start and end (to count how many ran at once) and failing
+    when a file name ends with ``fail``."""
+    script = tmp_path / "cc.sh"
+    log = tmp_path / "cc.log"
+    script.write_text("#!/bin/sh\n"
+                      f'echo "start $$" >> {log}\n'
+                      + (f'for a in "$@"; do case "$a" in *{fail}) echo "end $$" >> {log}; exit 1;; esac; done\n'
+                         if fail else "")
+                      + f'sleep 0.2; gcc "$@"; rc=$?\necho "end $$" >> {log}\nexit $rc\n')
+    script.chmod(0o755)
+    return str(script)
+
+
+def test_a_batch_runs_as_many_compilers_at_once_as_it_has_cores(tmp_path, monkeypatch):
+    """Two long blocks built together on two cores: their files are compiled two at a time, never more, and both
+    libraries land with the right bits."""
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
+    monkeypatch.setattr(compiled_module, "UNIT_STATEMENTS", 1500)
+    monkeypatch.setattr(compiled_module.os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    monkeypatch.setenv("CC", _logging_compiler(tmp_path))
+    fns = [_long_function(3 * compiled_module.SPLIT_FROM + 60 * k, f"long{k}") for k in range(2)]
+    with built_together():
+        for fn in fns:
+            compiled(fn, "O1")
+    running, most = 0, 0
+    for line in (tmp_path / "cc.log").read_text().split("\n"):
+        running += {"start": 1, "end": -1}.get(line.split(" ")[0], 0)
+        most = max(most, running)
+    assert most == 2 and running == 0
+    rng = np.random.default_rng(13)
+    for fn in fns:
+        library = compiled(fn, "O1")
+        assert library.class_name() == "External"
+        args = _random_args(fn, rng)
+        assert all(np.array_equal(np.array(t), np.array(g)) for t, g in zip(fn(*args), library(*args), strict=True))
+
+
+def test_a_file_that_fails_to_compile_leaves_the_block_interpreted(tmp_path, monkeypatch):
+    """When one of a library's files fails to compile, no library lands and no lock is left: the block is the
+    interpreted function, with the same values."""
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
+    monkeypatch.setattr(compiled_module, "UNIT_STATEMENTS", 1500)
+    monkeypatch.setenv("CC", _logging_compiler(tmp_path, fail="_2.c"))
+    fn = _long_function(3 * compiled_module.SPLIT_FROM)
+    for inside in (False, True):
+        if inside:
+            with built_together():
+                compiled(fn, "O1")
+        block = compiled(fn, "O1") if not inside else None
+        assert not list(cache.glob("*.so")) and not list(cache.glob("*.lock"))
+        if block is not None:
+            assert block.class_name() != "External"
+            args = _random_args(fn, np.random.default_rng(14))
+            assert all(np.array_equal(np.array(t), np.array(g)) for t, g in zip(fn(*args), block(*args), strict=True))
+    assert "_1.c" in " ".join(compiled_module._build_steps(compiled_module._source(fn), "O1", tmp_path / "fn",
+                                                           tmp_path / "x.so")[0][1])

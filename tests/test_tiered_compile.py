@@ -255,8 +255,8 @@ def test_an_interrupted_batch_leaves_no_lock_behind(tmp_path, monkeypatch):
     monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
     finished = compiled_module._finish
 
-    def interrupted(build):
-        finished(build)
+    def interrupted(build, locked):
+        finished(build, locked)
         raise KeyboardInterrupt
 
     monkeypatch.setattr(compiled_module, "_finish", interrupted)
