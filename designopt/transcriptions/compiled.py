@@ -21,7 +21,8 @@ is the same to the last bit at any level, only faster compiled (the main job's d
 docs/benchmarks.md), and a first build need not wait for a long compile. With `tier_up_after` ``never`` nothing is
 built in the background: a tiered block is compiled at -O0 where it is first needed and stays there. A build that a
 solve waits for (a block at -O1 from `AUTO_O1_FROM` points, or a profile's ``compile="O1"``) compiles a long
-block's body in parts (`split_statements`), a quarter to a seventh of gcc's time for the same bits.
+block's body in parts (`split_statements`), a quarter to a seventh of gcc's time for the same bits, the parts
+grouped into several files that gcc compiles at once on the cores and links into one library (`translation_units`).
 """
 
 from __future__ import annotations
