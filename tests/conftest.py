@@ -14,10 +14,11 @@ from designopt.config import parse_config
 from designopt.problem import problem_from_config
 from designopt.solve import Seeded, SolverProfile, solve_guess, solve_one
 
-# No background builds while the suite runs (and in the CLI processes it starts): a new block is compiled at -O0
-# where it is first needed, never at -O1. Which blocks would cross the tier-up threshold, and which solves would run
-# interpreted before their library lands, depends on the machine's speed, and the builds would take the cores the
-# tests time nothing on. tests/test_tiered_compile.py turns them on where it tests them.
+# No background builds while the suite runs (and in the CLI processes it starts): a new block is compiled at
+# `FIRST_TIER` where it is first needed, large ones too, and never tiered up. Which blocks would cross the tier-up
+# threshold, and which solves would run interpreted before their library lands, depends on the machine's speed, and
+# the builds would take the cores the tests time nothing on. tests/test_tiered_compile.py turns them on where it
+# tests them.
 os.environ["DESIGNOPT_TIER_UP_AFTER"] = "never"
 
 @pytest.fixture(scope="module")

@@ -160,7 +160,8 @@ def test_compiled_block_gives_the_same_hessian(rng, tmp_path, monkeypatch):
 
 def test_auto_compiles_blocks_of_long_paths_at_o1(monkeypatch):
     """``auto`` (the profile's default) compiles a block evaluated at AUTO_O1_FROM points or more at O1 and one
-    at fewer points tiered (O0, then O1 once solved with long enough); any other mode is itself, and a block is
+    at fewer points tiered (`FIRST_TIER` where first needed, or a large one -O0, then O1 once solved with long
+    enough); any other mode is itself, and a block is
     never compiled at "auto"."""
     import designopt.transcriptions.hessian as hessian_module
 

@@ -108,8 +108,10 @@ def test_sources_of_other_shapes_are_left_whole():
 
 def test_the_background_tier_up_compiles_the_body_whole(tmp_path, monkeypatch):
     """A tier-up, which no solve waits for, builds its -O1 library from the whole body (the faster library), and it
-    gives the same bits as the interpreted function."""
+    gives the same bits as the interpreted function. (An -O0 library tiers up: a large block's, or here one built
+    with `FIRST_TIER` -O0.)"""
     monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled_module, "FIRST_TIER", "O0")
     monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
     fn = _long_function(3 * compiled_module.SPLIT_FROM)
     used = []
@@ -237,3 +239,29 @@ def test_a_file_that_fails_to_compile_leaves_the_block_interpreted(tmp_path, mon
             assert all(np.array_equal(np.array(t), np.array(g)) for t, g in zip(fn(*args), block(*args), strict=True))
     assert "_1.c" in " ".join(compiled_module._build_steps(compiled_module._source(fn), "O1", tmp_path / "fn",
                                                            tmp_path / "x.so")[0][1])
+
+
+def test_a_problem_built_cold_by_default_loads_final_o1_libraries(tmp_path, monkeypatch):
+    """The default compile mode on a short path (``auto``: tiered) builds every block of a problem the cache lacks
+    at -O1 where it is first needed (`FIRST_TIER`): the cache then holds -O1 libraries only, none is reported for a
+    tier-up, and the Hessian of the Lagrangian equals the interpreted one's to the bit."""
+    from designopt.config import parse_config
+    from designopt.problem import problem_from_config
+    from designopt.transcriptions import Collocation
+
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    cfg = {"toolpath": {"kind": "circle", "radius": 0.1, "waypoints": 5}, "robot": {"structure": "RRR",
+                                                                                    "dh": "generic"}}
+    nlp = Collocation().build(problem_from_config(parse_config(cfg))).nlp
+    assert compiled_module.level("auto", 5) == "tiered"
+    _, pieces = nlp.derivatives("auto")
+    assert nlp.tiered_libraries("auto") == ()
+    libraries = [p for p in tmp_path.glob("*.so") if not p.name.startswith("ldl_")]
+    assert libraries and {p.name.split(".")[1] for p in libraries} == {"O1"}
+    assert not list(tmp_path.glob("*.c.gz"))
+    _, interpreted = nlp.derivatives("none")
+    rng = np.random.default_rng(15)
+    args = [rng.normal(size=nlp.n_variables), ca.DM(0, 1), 1.0, rng.normal(size=nlp.n_constraints)]
+    compiled_h, interpreted_h = pieces["hess_lag"](*args), interpreted["hess_lag"](*args)
+    assert np.array_equal(np.array(ca.DM(compiled_h)), np.array(ca.DM(interpreted_h)))

@@ -1,8 +1,11 @@
-"""Tiered compilation of the per-waypoint blocks (`designopt.transcriptions.compiled`): -O0 first (a large block
-interpreted while gcc builds it in the background), -O1 once the solves that used a block add up to the tier-up
-threshold. The two levels must compute the same numbers to the last
-bit (a solve may switch levels between runs and must not change), which is checked here against the interpreted
-function as the independent truth."""
+"""Tiered compilation of the per-waypoint blocks (`designopt.transcriptions.compiled`): a new block built at
+`FIRST_TIER` (-O1) where first needed and final, or, when large, interpreted while gcc builds its -O0 library in the
+background, then -O1 once the solves that used the -O0 library add up to the tier-up threshold. Most tests here set
+`FIRST_TIER` to "O0" (the tiers as they were, which large blocks and libraries already in a cache still go through),
+so that small blocks exercise the -O0 -> -O1 path; the last ones test the default (and
+tests/test_split_compile.py a problem built cold by it). The levels must compute the same
+numbers to the last bit (a solve may switch levels between runs and must not change), which is checked here against
+the interpreted function as the independent truth."""
 
 from __future__ import annotations
 
@@ -13,6 +16,7 @@ import time
 
 import casadi as ca
 import numpy as np
+import pytest
 
 from designopt.config import parse_config
 from designopt.problem import problem_from_config
@@ -30,6 +34,12 @@ from designopt.transcriptions.compiled import (
     tiered_up,
 )
 from designopt.transcriptions.hessian import block_hessian_function
+
+
+@pytest.fixture(autouse=True)
+def o0_first(monkeypatch):
+    """-O0 first for small blocks too (see the module's doc); the tests of the default set it back."""
+    monkeypatch.setattr(compiled_module, "FIRST_TIER", "O0")
 
 
 def _stem(library):
@@ -511,3 +521,40 @@ def test_a_build_lock_of_a_process_that_died_is_taken_over(tmp_path, monkeypatch
         compiled_module._build_all([(source, library)], wait_s=0.5)
         assert library.exists() == (name == "dead"), name
         assert library.with_name(f"{library.name}.lock").exists() == (name != "dead"), name
+
+
+def test_a_new_block_is_built_at_the_first_tier_and_stays_there(tmp_path, monkeypatch):
+    """With `FIRST_TIER` -O1 (the default) a new small tiered block gets an -O1 library where it is first needed,
+    inside a batch or not: final, so it is not reported for the tier-up, no source is kept and no solve is counted;
+    it computes what the interpreted function does. A large block is still interpreted while its -O0 library builds
+    in the background, and without background builds it is built here at -O1 too."""
+    monkeypatch.setattr(compiled_module, "FIRST_TIER", "O1")
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "60")
+    x = ca.SX.sym("x", 3)
+    alone = ca.Function("blk51", [x], [ca.cos(x[0]) * ca.sumsqr(x) - x[1] / (2 + x[2] ** 2)])
+    batched = ca.Function("blk52", [x], [ca.sin(x[1]) * ca.sumsqr(x)])
+    used = []
+    first = compiled(alone, "tiered", used)
+    with built_together() as batch:
+        compiled(batched, "tiered", used)
+    assert [library.name.split(".")[1] for _, library in batch.here] == ["O1"]
+    second = compiled(batched, "tiered", used)
+    assert used == [] and first.class_name() == second.class_name() == "External"
+    assert sorted(p.name.split(".")[1] for p in tmp_path.glob("*.so")) == ["O1", "O1"]
+    assert not list(tmp_path.glob("*.c.gz")) and not list(tmp_path.glob("*.work"))
+    rng = np.random.default_rng(9)
+    for _ in range(50):
+        x0 = rng.normal(size=3)
+        assert np.array_equal(np.array(first(x0)), np.array(alone(x0)))
+        assert np.array_equal(np.array(second(x0)), np.array(batched(x0)))
+    monkeypatch.setattr(compiled_module, "BACKGROUND_FROM_BYTES", 0)
+    large = ca.Function("blk53", [x], [ca.tanh(x[2]) * ca.sumsqr(x)])
+    reported = []
+    compiled(large, "tiered", reported)
+    assert reported == [interpreted_at(_stem(reported[0]))] and _landed(reported, "O0")
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "never")
+    never = ca.Function("blk54", [x], [ca.exp(x[2]) * ca.sumsqr(x)])
+    kept = []
+    assert compiled(never, "tiered", kept).class_name() == "External" and kept == []
+    assert [p.name.split(".")[1] for p in tmp_path.glob("blk54*.so")] == ["O1"]

@@ -9,17 +9,17 @@ on as many of them at once as there are cores, and a library another process is 
 starting on one shape) is waited for, not built twice.
 
 Tiered compilation (level ``tiered``, what ``auto`` gives a block evaluated at few points): a block the cache has no
-library of yet is compiled at -O0 where it is first needed (about 2 s for the main job's Hessian block), or, when
-its C source is large (`BACKGROUND_FROM_BYTES`: a cell's Hessian block, about 4 s of gcc), interpreted at once while
-gcc builds it in a detached background process; later builds, in any process, load that library (a worker's cached
-solver is built again once all of its blocks have theirs: `tiered_up`). Every solve that used a tiered block adds
+library of yet is compiled at `FIRST_TIER` (-O1) where it is first needed, and that library is final; or, when its
+C source is large (`BACKGROUND_FROM_BYTES`: a cell's Hessian block), it is interpreted at once while gcc builds its
+-O0 library in a detached background process; later builds, in any process, load that library (a worker's cached
+solver is built again once all of its blocks have theirs: `tiered_up`). Every solve that used an -O0 library adds
 its seconds to the block's record in the cache, and once those reach `tier_up_after` seconds the same C source is
-compiled again at -O1 in the background (about 10 s for that block), which later builds load instead (`designopt
-cache` shows where each block stands). Every library is compiled with ``-ffp-contract=off`` (and never with
--ffast-math), so CasADi's virtual machine, -O0 and -O1 compute the same IEEE operations in the same order: a solve
-is the same to the last bit at any level, only faster compiled (the main job's default search: 0.79x the CPU at -O1,
-docs/benchmarks.md), and a first build need not wait for a long compile. With `tier_up_after` ``never`` nothing is
-built in the background: a tiered block is compiled at -O0 where it is first needed and stays there. A build that a
+compiled again at -O1 in the background (its body whole), which later builds load instead (`designopt cache` shows
+where each block stands). Every library is compiled with ``-ffp-contract=off`` (and never with -ffast-math), so
+CasADi's virtual machine, -O0 and -O1 compute the same IEEE operations in the same order: a solve is the same to the
+last bit at any level, only faster compiled (an exploration iteration of the main job 0.70x at -O1), and a first
+build need not wait for a long compile. With `tier_up_after` ``never`` nothing is built in the background: a tiered
+block is compiled at `FIRST_TIER` where it is first needed. A build that a
 solve waits for (a block at -O1 from `AUTO_O1_FROM` points, or a profile's ``compile="O1"``) compiles a long
 block's body in parts (`split_statements`), a quarter to a seventh of gcc's time for the same bits, the parts
 grouped into several files that gcc compiles at once on the cores and links into one library (`translation_units`).
@@ -54,10 +54,16 @@ FLAGS = ("-fPIC", "-shared", "-ffp-contract=off")
 # program of 250 waypoints with a cell).
 # Below it, ``tiered``: O0 first, O1 once the block has been solved with long enough to pay for it (module doc).
 AUTO_O1_FROM = 500
-# Seconds of solves with a tiered block after which its -O1 build starts: the solving whose -O0 penalty (about a
-# fifth of it on the main job) adds up to what gcc -O1 takes for the main job's blocks (about 10 s) -- the
-# ski-rental rule, which never costs more than twice what knowing the future would. A sweep's structure is solved
-# for about 15 s and never tiers up; a task run again and again does from its second run.
+# The level a tiered block the cache has no library of is built at where it is first needed, unless its C source is
+# large (`BACKGROUND_FROM_BYTES`): -O1, a long body in parts on the cores (`translation_units`), and then final. On
+# two cores the main job's blocks build in 2.4-2.5 s instead of 1.5 s at -O0, and a cold default run
+# (`designopt run configs/milling.yaml`) takes 0.78x the wall of one that starts at -O0 and tiers up
+# (docs/decisions.md, Speed, 2026-12-07). "O0": the tiers as they were (-O0 first, -O1 after `TIER_UP_AFTER`).
+FIRST_TIER = "O1"
+# Seconds of solves with an -O0 library after which its -O1 build starts (a large block's, `BACKGROUND_FROM_BYTES`, or
+# one built with `FIRST_TIER` "O0"): the solving whose -O0 penalty (about a fifth of it on the main job) adds up to
+# what gcc -O1 takes for the main job's blocks whole (about 10 s) -- the ski-rental rule, which never costs more than
+# twice what knowing the future would.
 # `DESIGNOPT_TIER_UP_AFTER` (seconds, or ``never``) overrides it.
 TIER_UP_AFTER = 60.0
 # A tiered block whose C source has this many bytes or more, and no library yet, is interpreted while gcc builds its
@@ -166,10 +172,11 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
     so that a function found there is never derived (its symbolic derivation and serialisation are most of a
     warm build). Mode ``none``: ``derive()`` itself. Level ``tiered``: the -O1 library if the cache has it, else
     the -O0 one (its C source kept beside it for the tier-up), whose path is appended to ``used`` so that the
-    solves that use it can be counted (`record_work`); with neither in the cache, the -O0 library built here, or,
-    for C source of `BACKGROUND_FROM_BYTES` or more, ``derive()`` itself while its -O0 library is built in the
-    background (`build_later`), with its `interpreted_at` marker appended to ``used`` (`tiered_up` tells when the
-    library has landed). Without background builds (`tier_up_after` None) every -O0 library is built here."""
+    solves that use it can be counted (`record_work`); with neither in the cache, the `FIRST_TIER` library built
+    here (final: not appended), or, for C source of `BACKGROUND_FROM_BYTES` or more, ``derive()`` itself while its
+    -O0 library is built in the background (`build_later`), with its `interpreted_at` marker appended to ``used``
+    (`tiered_up` tells when the library has landed). Without background builds (`tier_up_after` None) every
+    library is built here."""
     if mode == "none":
         return derive()
     if mode not in ("O0", "O1", "O2", "tiered"):
@@ -194,6 +201,8 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
             if background and len(source) >= BACKGROUND_FROM_BYTES:
                 _keep_source(stem, source)
                 return _interpreted_meanwhile(stem, fn, used)
+            if tiered and FIRST_TIER != "O0":  # its first library is final: no -O0 library, no tier-up
+                mode, library = FIRST_TIER, library_at(stem, FIRST_TIER)
             if batch is not None:  # built on leaving `built_together`, with the batch's other blocks
                 batch.here.append((source, library))
                 return fn
