@@ -52,7 +52,8 @@ FLAGS = ("-fPIC", "-shared", "-ffp-contract=off")
 # and is most of an iteration on a long program, but gcc -O1 takes about 8 s for it (its body in parts; 35-60 s
 # whole) against 3 s: once per block and machine (the cache), paid back within one solve from some 500 points (a
 # program of 250 waypoints with a cell).
-# Below it, ``tiered``: O0 first, O1 once the block has been solved with long enough to pay for it (module doc).
+# Below it, ``tiered``: `FIRST_TIER` where first needed, or for a large block -O0 first and O1 once it has been
+# solved with long enough to pay for it (module doc).
 AUTO_O1_FROM = 500
 # The level a tiered block the cache has no library of is built at where it is first needed, unless its C source is
 # large (`BACKGROUND_FROM_BYTES`): -O1, a long body in parts on the cores (`translation_units`), and then final. On
@@ -85,7 +86,7 @@ SPLIT_EVERY = 150
 SPLIT_FROM = 2000  # statements: a shorter body compiles in a second or two whole
 # A split body's parts are compiled as files of about this many statements each, as many at once as there are cores,
 # and linked into one library (`translation_units`): on two cores the pocket cell's Hessian block (1.95 MB of C)
-# builds at -O1 in 3.5 s instead of 6.6 s, the same code (a call 24.6 against 25.6 us a point).
+# builds at -O1 in 3.5 s instead of 6.6 s, the same code (a call 24.4-24.6 against 25.6-26.2 us a point).
 UNIT_STATEMENTS = 6000
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
 
