@@ -202,7 +202,7 @@ def compiled_as(name: str, identity: str, derive: Callable[[], ca.Function], mod
             if background and len(source) >= BACKGROUND_FROM_BYTES:
                 _keep_source(stem, source)
                 return _interpreted_meanwhile(stem, fn, used)
-            if tiered and FIRST_TIER != "O0":  # its first library is final: no -O0 library, no tier-up
+            if tiered:  # its first library: final at -O1, or an -O0 one that tiers up
                 mode, library = FIRST_TIER, library_at(stem, FIRST_TIER)
             if batch is not None:  # built on leaving `built_together`, with the batch's other blocks
                 batch.here.append((source, library))
@@ -305,7 +305,7 @@ def build_later(stem: Path, level: str, background: bool = True) -> bool:
     try:
         c_file.write_bytes(gzip.decompress(source.read_bytes()))
         c, out = q(str(c_file)), q(str(tmp))
-        build = (f"{shlex.join(_compile_command(c_file, tmp, level))} && mv -f {out} {q(str(target))} && "
+        build = (f"{shlex.join(_compile_command([c_file], tmp, level))} && mv -f {out} {q(str(target))} && "
                  f"rm -f {q(str(lock))}; rm -f {out} {c}")
         # in the background the shell returns at once and the build, orphaned, outlives this process
         command = f"({build}) >/dev/null 2>&1" + (" &" if background else "")
@@ -395,11 +395,7 @@ def split_statements(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_F
     faster at -O1 (`SPLIT_EVERY`). A body of fewer than ``least`` statements, or C of any other shape (more than
     one function, a work vector, a branch), is returned as it is."""
     split = _split_parts(source, every, least)
-    if split is None:
-        return source
-    head, signature, tail, count, parts = split
-    defined = "".join(_part_definition(k, part, "static ") for k, part in enumerate(parts))
-    return head + defined + _entry(signature, count, len(parts)) + tail
+    return source if split is None else _one_file(*split)
 
 
 def translation_units(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_FROM,
@@ -413,13 +409,13 @@ def translation_units(source: str, every: int = SPLIT_EVERY, least: int = SPLIT_
     returns it, when the body is not split, fits one unit, or the preamble is not of the shape expected.
     ``per_unit``: `UNIT_STATEMENTS` unless given."""
     split = _split_parts(source, every, least)
-    preamble, marker, _ = source.partition(_EXPORTED)
-    if split is None or not marker or len(preamble) >= len(split[0]):
-        return [split_statements(source, every, least)]
+    if split is None:
+        return [source]
     head, signature, tail, count, parts = split
+    preamble, marker, _ = source.partition(_EXPORTED)
     group = max((UNIT_STATEMENTS if per_unit is None else per_unit) // every, 1)
-    if len(parts) <= group:
-        return [split_statements(source, every, least)]
+    if not marker or len(preamble) >= len(head) or len(parts) <= group:
+        return [_one_file(*split)]
     declared = "".join(f"{_SHARED_PART}void casadi_f0_part{k}{_PART_SIGNATURE};\n" for k in range(len(parts)))
     main = head + declared + _entry(signature, count, len(parts)) + tail
     shared = _HELPER.sub(r"static \1", preamble)
@@ -432,6 +428,12 @@ _EXPORTED = "/* Configuration this file was compiled with */"  # CasADi's preamb
 _HELPER = re.compile(r"^((?:casadi_real|casadi_int|int|void) casadi_\w+\()", re.M)
 _PART_SIGNATURE = "(const casadi_real** arg, casadi_real** res, casadi_real* restrict a)"
 _SHARED_PART = '__attribute__((noinline, visibility("hidden"))) '  # a part another file calls
+
+
+def _one_file(head: str, signature: str, tail: str, count: int, parts: list[str]) -> str:
+    """`_split_parts`'s analysis as one file of ``static`` parts (`split_statements`)."""
+    defined = "".join(_part_definition(k, part, "static ") for k, part in enumerate(parts))
+    return head + defined + _entry(signature, count, len(parts)) + tail
 
 
 def _part_definition(k: int, part: str, storage: str) -> str:
@@ -550,6 +552,10 @@ class _Build:
     running: list[subprocess.Popen] = field(default_factory=list)
     failed: bool = False
 
+    def __post_init__(self) -> None:
+        self.waiting = list(self.steps[0]) if self.steps else []
+        self.failed = self.failed or not self.steps
+
 
 def _run_builds(mine: list[tuple[Path, str]], locked: bool) -> None:
     """Build each (library, source) (`_build_steps`), up to the process's cores gcc processes at a time, the first
@@ -566,7 +572,7 @@ def _run_builds(mine: list[tuple[Path, str]], locked: bool) -> None:
                 steps = _build_steps(source, library.name.split(".")[-2], Path(tmp) / f"fn{k}", output)
             except OSError:
                 steps = []
-            builds.append(_Build(library, source, output, steps, failed=not steps))
+            builds.append(_Build(library, source, output, steps))
         try:
             _schedule(builds, cores, locked)
         finally:
@@ -578,8 +584,6 @@ def _run_builds(mine: list[tuple[Path, str]], locked: bool) -> None:
 def _schedule(builds: list[_Build], cores: int, locked: bool) -> None:
     """`_run_builds`'s loop: start commands while fewer than ``cores`` run, collect those that end, and finish each
     build whose last step has ended (or that failed)."""
-    for build in builds:
-        build.waiting = list(build.steps[0]) if build.steps else []
     active = list(builds)
     while active:
         free = cores - sum(len(b.running) for b in active)
@@ -632,13 +636,10 @@ def _build_steps(source: str, level: str, base: Path, library: Path) -> list[lis
     for file, text in zip(files, units, strict=True):
         file.write_text(text)
     if len(files) == 1:
-        return [[_compile_command(files[0], library, level)]]
+        return [[_compile_command(files, library, level)]]
     objects = [file.with_suffix(".o") for file in files]
-    compile_flags = [flag for flag in FLAGS if flag != "-shared"]
-    cc = os.environ.get("CC", "gcc")
-    compiles = [[cc, f"-{level}", *compile_flags, "-c", str(file), "-o", str(obj)]
-                for file, obj in zip(files, objects, strict=True)]
-    return [compiles, [[cc, f"-{level}", *FLAGS, *map(str, objects), "-o", str(library), "-lm"]]]
+    compiles = [_compile_command([file], obj, level, link=False) for file, obj in zip(files, objects, strict=True)]
+    return [compiles, [_compile_command(objects, library, level)]]
 
 
 def _lock_of(library: Path) -> Path:
@@ -654,10 +655,12 @@ def _build(source: str, library: Path, mode: str) -> None:
         raise subprocess.CalledProcessError(1, f"gcc -{mode} {library.name}")
 
 
-def _compile_command(c_file: Path, library: Path, mode: str) -> list[str]:
-    """The compiler's command line that builds ``c_file`` into the shared library ``library`` at level ``mode``
-    ($CC, or gcc)."""
-    return [os.environ.get("CC", "gcc"), f"-{mode}", *FLAGS, str(c_file), "-o", str(library), "-lm"]
+def _compile_command(inputs: list[Path], output: Path, mode: str, link: bool = True) -> list[str]:
+    """The compiler's command line ($CC, or gcc) at level ``mode`` that builds ``inputs`` (C files or objects) into
+    the shared library ``output``, or, without ``link``, one C file into the object ``output``."""
+    flags = FLAGS if link else [*(flag for flag in FLAGS if flag != "-shared"), "-c"]
+    return [os.environ.get("CC", "gcc"), f"-{mode}", *flags, *map(str, inputs), "-o", str(output),
+            *(["-lm"] if link else [])]
 
 
 @dataclass(frozen=True)
