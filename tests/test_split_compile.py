@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import re
 import subprocess
+import time
+from types import SimpleNamespace
 
 import casadi as ca
 import numpy as np
@@ -265,3 +267,50 @@ def test_a_problem_built_cold_by_default_loads_final_o1_libraries(tmp_path, monk
     args = [rng.normal(size=nlp.n_variables), ca.DM(0, 1), 1.0, rng.normal(size=nlp.n_constraints)]
     compiled_h, interpreted_h = pieces["hess_lag"](*args), interpreted["hess_lag"](*args)
     assert np.array_equal(np.array(ca.DM(compiled_h)), np.array(ca.DM(interpreted_h)))
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie, ended but not yet reaped by its parent, does not)."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+def test_an_interrupted_build_leaves_no_compiler_or_temporary_file_behind(tmp_path, monkeypatch):
+    """Interrupted while its compilers run (Ctrl-C), a build stops each compiler and the program it started (as gcc
+    starts cc1), and nothing they wrote to their temporary directory is left, in the cache or in the process's own
+    ``TMPDIR``."""
+    cache, own_tmp = tmp_path / "cache", tmp_path / "tmp"
+    own_tmp.mkdir()
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
+    monkeypatch.setenv("TMPDIR", str(own_tmp))
+    monkeypatch.setattr(compiled_module, "UNIT_STATEMENTS", 1500)
+    monkeypatch.setattr(compiled_module.os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    log = tmp_path / "pids.log"
+    script = tmp_path / "slowcc.sh"  # writes a temporary file as gcc does, then waits on a child as gcc on cc1
+    script.write_text("#!/bin/sh\n"
+                      'echo partial > "${TMPDIR:-/tmp}/ccslow$$.s"\n'
+                      f'sleep 60 & echo "$$ $!" >> {log}\nwait\n')
+    script.chmod(0o755)
+    monkeypatch.setenv("CC", str(script))
+    real_sleep = time.sleep
+
+    def interrupt_once_started(seconds):
+        if log.exists() and len(log.read_text().split("\n")) > 2:  # both compilers and their children are up
+            raise KeyboardInterrupt
+        real_sleep(seconds)
+
+    monkeypatch.setattr(compiled_module, "time", SimpleNamespace(time=time.time, sleep=interrupt_once_started))
+    fn = _long_function(3 * compiled_module.SPLIT_FROM)
+    try:
+        with built_together():
+            compiled(fn, "O1")
+        raised = False
+    except KeyboardInterrupt:
+        raised = True
+    pids = [int(p) for p in log.read_text().split()]
+    assert raised and len(pids) == 4
+    assert not any(_alive(pid) for pid in pids)
+    assert not list(own_tmp.iterdir()) and not list(cache.rglob("ccslow*")) and not list(cache.glob("*.lock"))

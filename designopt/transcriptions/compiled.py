@@ -32,11 +32,12 @@ import hashlib
 import os
 import re
 import shlex
+import signal
 import subprocess
 import tempfile
 import time
 from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -559,8 +560,9 @@ class _Build:
 
 def _run_builds(mine: list[tuple[Path, str]], locked: bool) -> None:
     """Build each (library, source) (`_build_steps`), up to the process's cores gcc processes at a time, the first
-    builds' commands first, each library moved into place as it lands (its lock released if ``locked``); on an
-    exception every gcc still running is killed."""
+    builds' commands first, each library moved into place as it lands (its lock released if ``locked``). gcc
+    writes its own temporary files (``TMPDIR``) into the build's directory, which goes with them; on an exception
+    every gcc still running is stopped with the programs it started (`_stop`)."""
     if not mine:
         return
     cores = max(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 1)
@@ -574,16 +576,14 @@ def _run_builds(mine: list[tuple[Path, str]], locked: bool) -> None:
                 steps = []
             builds.append(_Build(library, source, output, steps))
         try:
-            _schedule(builds, cores, locked)
+            _schedule(builds, cores, locked, {**os.environ, "TMPDIR": tmp})
         finally:
-            for build in builds:
-                for process in build.running:
-                    process.kill()
+            _stop([process for build in builds for process in build.running])
 
 
-def _schedule(builds: list[_Build], cores: int, locked: bool) -> None:
-    """`_run_builds`'s loop: start commands while fewer than ``cores`` run, collect those that end, and finish each
-    build whose last step has ended (or that failed)."""
+def _schedule(builds: list[_Build], cores: int, locked: bool, env: dict[str, str]) -> None:
+    """`_run_builds`'s loop: start commands (in environment ``env``, each its own process group) while fewer than
+    ``cores`` run, collect those that end, and finish each build whose last step has ended (or that failed)."""
     active = list(builds)
     while active:
         free = cores - sum(len(b.running) for b in active)
@@ -591,7 +591,8 @@ def _schedule(builds: list[_Build], cores: int, locked: bool) -> None:
             while free > 0 and build.waiting and not build.failed:
                 try:
                     build.running.append(subprocess.Popen(build.waiting.pop(0), stdin=subprocess.DEVNULL,
-                                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+                                                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                                                          env=env, start_new_session=True))
                     free -= 1
                 except OSError:
                     build.failed = True
@@ -611,6 +612,23 @@ def _schedule(builds: list[_Build], cores: int, locked: bool) -> None:
             _finish(build, locked)
         if active and not ended:
             time.sleep(0.005)
+
+
+def _stop(processes: list[subprocess.Popen], grace_s: float = 1.0) -> None:
+    """Stop compilers that are still running (an interrupt, an error): SIGTERM to each one's process group -- gcc
+    and the cc1, as and ld it started, which SIGKILL to gcc alone would leave running -- so that gcc removes its
+    temporary files; SIGKILL to a group whose gcc has not ended ``grace_s`` seconds later."""
+    for process in processes:
+        with suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGTERM)
+    deadline = time.time() + grace_s
+    for process in processes:
+        try:
+            process.wait(timeout=max(deadline - time.time(), 0.01))
+        except subprocess.TimeoutExpired:
+            with suppress(ProcessLookupError):
+                os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
 
 
 def _finish(build: _Build, locked: bool) -> None:
