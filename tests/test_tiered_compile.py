@@ -505,6 +505,27 @@ def test_the_cache_command_counts_levels_and_records_and_clears(tmp_path, monkey
     assert cleared.exit_code == 0 and "removed" in cleared.output and not list(tmp_path.iterdir())
 
 
+def test_a_killed_builds_directory_is_cleared_once_stale(tmp_path, monkeypatch):
+    """A build's working directory left by a process killed mid-build is a file of no current kind once untouched
+    for `STALE_LOCK_S` (--clear-other removes it, with what is in it); a build's directory under way is not, and
+    --clear removes it too."""
+    from designopt.transcriptions.compiled import BUILD_DIR_PREFIX, cache_report, clear_cache
+
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(tmp_path))
+    dead, alive = tmp_path / f"{BUILD_DIR_PREFIX}dead", tmp_path / f"{BUILD_DIR_PREFIX}alive"
+    for d in (dead, alive):
+        d.mkdir()
+        (d / "fn0_0.c").write_text("int f;")
+        (d / "ccX.s").write_text("partial")
+    old = time.time() - compiled_module.STALE_LOCK_S - 60
+    os.utime(dead, (old, old))
+    report = cache_report()
+    assert report.other == 1 and report.bytes == 13
+    assert clear_cache(only_other=True) == (2, 13)
+    assert not dead.exists() and alive.exists() and cache_report().other == 0
+    assert clear_cache() == (2, 13) and not list(tmp_path.iterdir())
+
+
 def test_a_build_lock_of_a_process_that_died_is_taken_over(tmp_path, monkeypatch):
     """A foreground build's lock names its process: one left by a process that died mid-build (a sweep killed during
     gcc) is taken over and the library built, not waited for; a live process's lock, and a background build's lock

@@ -32,6 +32,7 @@ import hashlib
 import os
 import re
 import shlex
+import shutil
 import signal
 import subprocess
 import tempfile
@@ -90,6 +91,7 @@ SPLIT_FROM = 2000  # statements: a shorter body compiles in a second or two whol
 # builds at -O1 in 3.5 s instead of 6.6 s, the same code (a call 24.4-24.6 against 25.6-26.2 us a point).
 UNIT_STATEMENTS = 6000
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
+BUILD_DIR_PREFIX = "build-"  # a build's working directory in the cache (`_run_builds`): its C files and gcc's own
 
 
 @dataclass
@@ -566,7 +568,7 @@ def _run_builds(mine: list[tuple[Path, str]], locked: bool) -> None:
     if not mine:
         return
     cores = max(len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1, 1)
-    with tempfile.TemporaryDirectory(dir=mine[0][0].parent) as tmp:
+    with tempfile.TemporaryDirectory(dir=mine[0][0].parent, prefix=BUILD_DIR_PREFIX) as tmp:
         builds = []
         for k, (library, source) in enumerate(mine):
             output = Path(tmp) / f"{k}_{library.name}"
@@ -685,8 +687,8 @@ def _compile_command(inputs: list[Path], output: Path, mode: str, link: bool = T
 class CacheReport:
     """What the compile cache holds: libraries by level (``tiered_up``: -O1 libraries built from a tiered block's
     kept source), blocks still counting towards their tier-up and the seconds of solving each has, tier-up builds
-    under way (locks), files of no current kind (an older designopt's libraries, temporary files of a build that
-    died), and the bytes of it all."""
+    under way (locks), files of no current kind (an older designopt's libraries, the working directory of a build
+    whose process was killed: `_dead_build`), and the bytes of it all."""
 
     path: Path
     libraries: dict[str, int]
@@ -714,10 +716,24 @@ def _kind(name: str) -> str:
     return "other"
 
 
+def _dead_build(directory: Path) -> bool:
+    """Whether ``directory`` in the cache is a build's working directory (`_run_builds`) untouched for
+    `STALE_LOCK_S`: left by a process that was killed (SIGKILL) before it could remove it."""
+    return directory.name.startswith(BUILD_DIR_PREFIX) and time.time() - directory.stat().st_mtime > STALE_LOCK_S
+
+
+def _size(directory: Path) -> tuple[int, int]:
+    """(files, bytes) below ``directory``."""
+    files = [f for f in directory.rglob("*") if f.is_file()]
+    return len(files), sum(f.stat().st_size for f in files)
+
+
 def cache_report(path: Path | None = None) -> CacheReport:
-    """What the compile cache (`cache_dir`, or ``path``) holds."""
+    """What the compile cache (`cache_dir`, or ``path``) holds; a dead build's directory counts as one file of no
+    current kind."""
     path = cache_dir() if path is None else path
     files = [f for f in path.iterdir() if f.is_file()] if path.is_dir() else []
+    dead = [d for d in path.iterdir() if d.is_dir() and _dead_build(d)] if path.is_dir() else []
     kinds = {f: _kind(f.name) for f in files}
     names = {f.name for f in files}
     libraries = {level: sum(k == level for k in kinds.values()) for level in ("O0", "O1", "O2")}
@@ -735,19 +751,26 @@ def cache_report(path: Path | None = None) -> CacheReport:
     return CacheReport(path=path, libraries=libraries, tiered_up=tiered_up,
                        counting=tuple(sorted(counting, key=lambda c: -c[1])),
                        building=sum(k == "lock" for k in kinds.values()),
-                       other=sum(k == "other" for k in kinds.values()),
-                       bytes=sum(f.stat().st_size for f in files))
+                       other=sum(k == "other" for k in kinds.values()) + len(dead),
+                       bytes=sum(f.stat().st_size for f in files) + sum(_size(d)[1] for d in dead))
 
 
 def clear_cache(path: Path | None = None, only_other: bool = False) -> tuple[int, int]:
-    """Delete the compile cache's files (only those of no current kind with ``only_other``): (files, bytes)
-    removed. Libraries are compiled again when next needed."""
+    """Delete the compile cache's files and directories (only those of no current kind and dead builds'
+    directories, `_dead_build`, with ``only_other``): (files, bytes) removed. Libraries are compiled again when next
+    needed."""
     path = cache_dir() if path is None else path
     removed = freed = 0
-    for f in (f for f in path.iterdir() if f.is_file()) if path.is_dir() else ():
-        if only_other and _kind(f.name) != "other":
-            continue
-        size = f.stat().st_size
-        f.unlink(missing_ok=True)
-        removed, freed = removed + 1, freed + size
+    for entry in list(path.iterdir()) if path.is_dir() else ():
+        if entry.is_dir():
+            if only_other and not _dead_build(entry):
+                continue
+            files, size = _size(entry)
+            shutil.rmtree(entry, ignore_errors=True)
+        else:
+            if only_other and _kind(entry.name) != "other":
+                continue
+            files, size = 1, entry.stat().st_size
+            entry.unlink(missing_ok=True)
+        removed, freed = removed + files, freed + size
     return removed, freed
