@@ -91,7 +91,7 @@ SPLIT_FROM = 2000  # statements: a shorter body compiles in a second or two whol
 # builds at -O1 in 3.5 s instead of 6.6 s, the same code (a call 24.4-24.6 against 25.6-26.2 us a point).
 UNIT_STATEMENTS = 6000
 STALE_LOCK_S = 1800.0  # a tier-up lock older than this is taken to be from a build that died
-BUILD_DIR_PREFIX = "build-"  # a build's working directory in the cache (`_run_builds`): its C files and gcc's own
+BUILD_DIR_PREFIX = "build-"  # a build's working directory in the cache (`_run_builds`): its C, objects, gcc temporaries
 
 
 @dataclass
@@ -719,13 +719,21 @@ def _kind(name: str) -> str:
 def _dead_build(directory: Path) -> bool:
     """Whether ``directory`` in the cache is a build's working directory (`_run_builds`) untouched for
     `STALE_LOCK_S`: left by a process that was killed (SIGKILL) before it could remove it."""
-    return directory.name.startswith(BUILD_DIR_PREFIX) and time.time() - directory.stat().st_mtime > STALE_LOCK_S
+    try:
+        return directory.name.startswith(BUILD_DIR_PREFIX) and time.time() - directory.stat().st_mtime > STALE_LOCK_S
+    except FileNotFoundError:  # its build has just ended
+        return False
 
 
 def _size(directory: Path) -> tuple[int, int]:
-    """(files, bytes) below ``directory``."""
-    files = [f for f in directory.rglob("*") if f.is_file()]
-    return len(files), sum(f.stat().st_size for f in files)
+    """(files, bytes) below ``directory`` (a file that goes meanwhile, a build's that ends, counts nothing)."""
+    files = sizes = 0
+    for f in directory.rglob("*"):
+        with suppress(OSError):
+            if f.is_file():
+                sizes += f.stat().st_size
+                files += 1
+    return files, sizes
 
 
 def cache_report(path: Path | None = None) -> CacheReport:
