@@ -328,6 +328,28 @@ def test_failed_solves_are_rows(tmp_path, capfd):
     assert "overconstrained" not in captured.out + captured.err
 
 
+def test_a_problem_with_too_few_degrees_of_freedom_compiles_nothing(tmp_path, monkeypatch):
+    """One revolute joint against five tracking equalities per waypoint: IPOPT would stop before its first
+    iteration, so the solver is prepared without building the NLP's derivatives -- no block reaches the compile
+    cache -- and the solve is its status at once."""
+    from designopt.experiments.sweep import structure_config
+    from designopt.problem import problem_from_config
+    from designopt.solve import local
+    from designopt.transcriptions.collocation import Collocation
+
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
+    problem = problem_from_config(structure_config(load_config(small_config(tmp_path)), "R"))
+    built, solver, _ = local.prepared(problem, Collocation(), SolverProfile(max_iter=3, compile="O1"))
+    assert built.nlp.n_equalities > built.nlp.n_variables
+    outcome = solver.solve(np.zeros(built.nlp.n_variables))
+    assert outcome.status == "Not_Enough_Degrees_Of_Freedom" and outcome.iterations == 0
+    assert not list(cache.glob("*.so"))
+    rr = problem_from_config(structure_config(load_config(small_config(tmp_path)), "RR"))
+    local.prepared(rr, Collocation(), SolverProfile(max_iter=3, compile="O1"))  # one that can move is built
+    assert list(cache.glob("*.so"))
+
+
 def test_held_joints_solve_without_casadis_warning(tmp_path, capfd):
     """A 2-joint arm on a few waypoints has a few more variables than equalities; with more design joints than
     that held (lbx == ubx, as the hold of a degenerate design does) CasADi counts the held joints as equalities

@@ -135,11 +135,17 @@ class PreparedIpopt:
     def __init__(self, nlp: NLP, profile):
         t0 = time.perf_counter()
         self.nlp = nlp
+        self.observers = make_observers(profile.observers, nlp.problem)
+        self._callback = None  # CasADi keeps no Python reference: the callback must live as long as the solver
+        self.lbx, self.ubx = nlp.lbx, nlp.ubx
+        self._casadi_warns = False
+        self.solver = None
+        if nlp.n_equalities > nlp.n_variables:  # never solved (`solve`): nothing to compile or build
+            self.prepare_time_s = time.perf_counter() - t0
+            return
         opts = options(profile, nlp.n_variables)
         problem, derivatives = nlp.derivatives(profile.compile)
         opts.update(derivatives)
-        self.observers = make_observers(profile.observers, nlp.problem)
-        self._callback = None  # CasADi keeps no Python reference: the callback must live as long as the solver
         if self.observers:
             self._callback = _Observe(self.observers, nlp.n_variables, nlp.n_constraints, nlp.n_design,
                                       np.asarray(nlp.lbg, float), np.asarray(nlp.ubg, float))
@@ -150,7 +156,6 @@ class PreparedIpopt:
         # every solve when that count exceeds the variables, although IPOPT removes them and solves (a held planar
         # arm's tracking rows are redundant, not too many: the sweep's held RR, RP, PR on 10 waypoints converge).
         self._casadi_warns = nlp.n_equalities + int(np.sum(nlp.lbx == nlp.ubx)) > nlp.n_variables
-        self.lbx, self.ubx = nlp.lbx, nlp.ubx
         self.prepare_time_s = time.perf_counter() - t0
 
     def bounded(self, lower: np.ndarray, upper: np.ndarray) -> PreparedIpopt:
