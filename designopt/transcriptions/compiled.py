@@ -619,18 +619,33 @@ def _schedule(builds: list[_Build], cores: int, locked: bool, env: dict[str, str
 def _stop(processes: list[subprocess.Popen], grace_s: float = 1.0) -> None:
     """Stop compilers that are still running (an interrupt, an error): SIGTERM to each one's process group -- gcc
     and the cc1, as and ld it started, which SIGKILL to gcc alone would leave running -- so that gcc removes its
-    temporary files; SIGKILL to a group whose gcc has not ended ``grace_s`` seconds later."""
+    temporary files; SIGKILL to the groups that still have a process ``grace_s`` seconds later."""
     for process in processes:
         with suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGTERM)
     deadline = time.time() + grace_s
     for process in processes:
-        try:
+        with suppress(subprocess.TimeoutExpired):
             process.wait(timeout=max(deadline - time.time(), 0.01))
-        except subprocess.TimeoutExpired:
-            with suppress(ProcessLookupError):
-                os.killpg(process.pid, signal.SIGKILL)
-            process.wait()
+    waiting = list(processes)
+    while waiting and time.time() < deadline:  # the programs gcc started end after it
+        waiting = [p for p in waiting if _group_alive(p.pid)]
+        if waiting:
+            time.sleep(0.01)
+    for process in waiting:
+        with suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
+    for process in processes:
+        process.wait()
+
+
+def _group_alive(group: int) -> bool:
+    """Whether process group ``group`` still has a process (one that has ended but not been reaped counts)."""
+    try:
+        os.killpg(group, 0)
+    except ProcessLookupError:
+        return False
+    return True
 
 
 def _finish(build: _Build, locked: bool) -> None:
