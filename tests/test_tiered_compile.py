@@ -153,7 +153,7 @@ def test_a_failed_background_build_leaves_the_block_interpreted(tmp_path, monkey
     stem = _stem(used[0])
     lock = library_at(stem, "O0").with_name(library_at(stem, "O0").name + ".lock")
     deadline = time.time() + 30
-    while time.time() < deadline and list(tmp_path.glob("*.tmp*")):
+    while time.time() < deadline and list(tmp_path.glob("build-*")):
         time.sleep(0.1)
     assert lock.exists() and not library_at(stem, "O0").exists() and not tiered_up(used)
     mtime = lock.stat().st_mtime
@@ -435,8 +435,28 @@ def test_a_failed_build_is_not_retried_after_every_solve(tmp_path, monkeypatch):
     target = library_at(_stem(used[0]), "O1")
     assert record_work(used, 1.0, background=False) == used  # started, and failed
     assert not target.exists() and target.with_name(target.name + ".lock").exists()
-    assert not list(tmp_path.glob("*.tmp*"))
+    assert not list(tmp_path.glob("build-*"))
     assert record_work(used, 1.0, background=False) == []
+
+
+def test_a_tier_up_build_writes_its_temporary_files_in_its_own_directory(tmp_path, monkeypatch):
+    """gcc's temporary files of a tier-up build go into the build's working directory in the cache, which goes when
+    the build ends, landed or failed: none reach the process's own ``TMPDIR``."""
+    cache, own_tmp = tmp_path / "cache", tmp_path / "tmp"
+    own_tmp.mkdir()
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
+    monkeypatch.setenv("TMPDIR", str(own_tmp))
+    cc = tmp_path / "cc.sh"  # leaves a file in its temporary directory, as a killed gcc would
+    cc.write_text('#!/bin/sh\necho partial > "${TMPDIR:-/tmp}/cckept$$.s"\nexec gcc "$@"\n')
+    cc.chmod(0o755)
+    x = ca.SX.sym("x", 2)
+    used = []
+    compiled(ca.Function("blk9", [x], [ca.exp(x[1]) * x[0]]), "tiered", used)
+    monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
+    monkeypatch.setenv("CC", str(cc))
+    assert record_work(used, 1.0, background=False) == used
+    assert library_at(_stem(used[0]), "O1").exists()
+    assert not list(own_tmp.iterdir()) and not list(cache.glob("build-*")) and not list(cache.rglob("cckept*"))
 
 
 def test_a_cache_that_cannot_be_written_leaves_the_solve_alone(tmp_path, monkeypatch):

@@ -294,27 +294,30 @@ def tier_up(stem: Path, background: bool = True) -> bool:
 
 
 def build_later(stem: Path, level: str, background: bool = True) -> bool:
-    """Build ``stem``'s kept C source at ``level`` into its library (atomically: under a temporary name, then
-    renamed), in a detached background process, or here when ``background`` is false. False when there is no
-    source, or another process holds the build's lock. A build that fails keeps its lock, so that it is tried
-    again only once the lock is stale (`STALE_LOCK_S`), not after every solve."""
+    """Build ``stem``'s kept C source at ``level`` into its library (atomically: in a working directory of its own
+    in the cache, where gcc also writes its temporary files, then renamed into place), in a detached background
+    process, or here when ``background`` is false. False when there is no source, or another process holds the
+    build's lock. A build that fails keeps its lock, so that it is tried again only once the lock is stale
+    (`STALE_LOCK_S`), not after every solve; one that is killed leaves its directory (`_dead_build`)."""
     source, target = source_of(stem), library_at(stem, level)
     lock = _lock_of(target)
     if not source.exists() or not _take(lock):
         return False
-    tmp = target.with_name(f"{target.name}.{os.getpid()}.tmp")
-    c_file = tmp.with_name(f"{tmp.name}.c")
+    work = None
     q = shlex.quote
     try:
+        work = Path(tempfile.mkdtemp(dir=target.parent, prefix=BUILD_DIR_PREFIX))
+        tmp, c_file = work / target.name, work / f"{stem.name}.c"
         c_file.write_bytes(gzip.decompress(source.read_bytes()))
-        c, out = q(str(c_file)), q(str(tmp))
-        build = (f"{shlex.join(_compile_command([c_file], tmp, level))} && mv -f {out} {q(str(target))} && "
-                 f"rm -f {q(str(lock))}; rm -f {out} {c}")
+        out = q(str(tmp))
+        build = (f"TMPDIR={q(str(work))} {shlex.join(_compile_command([c_file], tmp, level))} && "
+                 f"mv -f {out} {q(str(target))} && rm -f {q(str(lock))}; rm -rf {q(str(work))}")
         # in the background the shell returns at once and the build, orphaned, outlives this process
         command = f"({build}) >/dev/null 2>&1" + (" &" if background else "")
         subprocess.run(["sh", "-c", command], check=False, stdin=subprocess.DEVNULL)
     except (OSError, EOFError, gzip.BadGzipFile):
-        c_file.unlink(missing_ok=True)
+        if work is not None:
+            shutil.rmtree(work, ignore_errors=True)
         lock.unlink(missing_ok=True)
         return False
     return True
