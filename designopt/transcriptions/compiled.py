@@ -626,13 +626,9 @@ def _stop(processes: list[subprocess.Popen], grace_s: float = 1.0) -> None:
     for process in processes:
         with suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGTERM)
-    deadline = time.time() + grace_s
-    for process in processes:
-        with suppress(subprocess.TimeoutExpired):
-            process.wait(timeout=max(deadline - time.time(), 0.01))
-    waiting = list(processes)
-    while waiting and time.time() < deadline:  # the programs gcc started end after it
-        waiting = [p for p in waiting if _group_alive(p.pid)]
+    deadline, waiting = time.time() + grace_s, list(processes)
+    while waiting and time.time() < deadline:  # gcc (reaped here), then the programs it started
+        waiting = [p for p in waiting if p.poll() is None or _group_alive(p.pid)]
         if waiting:
             time.sleep(0.01)
     for process in waiting:
