@@ -20,7 +20,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from designopt.transcriptions.compiled import cache_dir
+from designopt.transcriptions.compiled import BUILD_DIR_PREFIX, cache_dir
 
 HERE = Path(__file__).resolve().parent
 SOURCES = (HERE / "ma27.c", HERE / "qdldl.c", *sorted((HERE / "amd").glob("*.c")))
@@ -43,11 +43,12 @@ def library() -> Path | None:
     if target.exists():
         return target
     try:
-        with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
+        # gcc's temporary files in the build's own directory, which goes with it (`compiled.BUILD_DIR_PREFIX`)
+        with tempfile.TemporaryDirectory(dir=target.parent, prefix=BUILD_DIR_PREFIX) as tmp:
             out = Path(tmp) / target.name
             command = [os.environ.get("CC", "gcc"), *FLAGS, f"-I{HERE}", f"-I{HERE / 'amd'}",
                        *map(str, SOURCES), "-o", str(out), "-lm"]
-            subprocess.run(command, check=True, capture_output=True)
+            subprocess.run(command, check=True, capture_output=True, env={**os.environ, "TMPDIR": tmp})
             os.replace(out, target)
     except (OSError, subprocess.CalledProcessError):
         return None
