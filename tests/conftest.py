@@ -78,6 +78,23 @@ def config(data: dict, base_dir=None):
 
 
 @pytest.fixture
+def temp_keeping_compiler(tmp_path, monkeypatch):
+    """(compile cache, this process's own TMPDIR), both made under ``tmp_path`` and set, with $CC a gcc that first
+    leaves a file (``cckept*``) in its temporary directory, as a killed gcc would: for the tests that gcc's
+    temporary files stay in the build's own directory."""
+    cache, own_tmp = tmp_path / "cache", tmp_path / "tmp"
+    cache.mkdir()
+    own_tmp.mkdir()
+    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
+    monkeypatch.setenv("TMPDIR", str(own_tmp))
+    cc = tmp_path / "cc.sh"
+    cc.write_text('#!/bin/sh\necho partial > "${TMPDIR:-/tmp}/cckept$$.s"\nexec gcc "$@"\n')
+    cc.chmod(0o755)
+    monkeypatch.setenv("CC", str(cc))
+    return cache, own_tmp
+
+
+@pytest.fixture
 def gantry_problem():
     return problem_from_config(parse_config(gantry_config()))
 

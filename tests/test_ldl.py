@@ -244,18 +244,10 @@ def test_an_objective_scaled_while_ipopt_iterates_reaches_the_same_optimum_repor
     assert objectives[1] == pytest.approx(objectives[0], rel=1e-6)  # reported as the NLP's, not 100x
 
 
-def test_the_library_build_writes_its_temporary_files_in_its_own_directory(tmp_path, monkeypatch):
+def test_the_library_build_writes_its_temporary_files_in_its_own_directory(temp_keeping_compiler):
     """gcc's temporary files of the KKT solver's build go into the build's directory in the cache, which goes with
     it: none reach the process's own ``TMPDIR``, and the library lands."""
-    cache, own_tmp = tmp_path / "cache", tmp_path / "tmp"
-    cache.mkdir()
-    own_tmp.mkdir()
-    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
-    monkeypatch.setenv("TMPDIR", str(own_tmp))
-    cc = tmp_path / "cc.sh"  # leaves a file in its temporary directory, as a killed gcc would
-    cc.write_text('#!/bin/sh\necho partial > "${TMPDIR:-/tmp}/cckept$$.s"\nexec gcc "$@"\n')
-    cc.chmod(0o755)
-    monkeypatch.setenv("CC", str(cc))
+    cache, own_tmp = temp_keeping_compiler
     built = ldl.library.__wrapped__()
     assert built is not None and built.parent == cache and built.exists()
     assert not list(own_tmp.iterdir()) and not list(cache.rglob("cckept*")) and not list(cache.glob("build-*"))

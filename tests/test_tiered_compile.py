@@ -442,21 +442,14 @@ def test_a_failed_build_is_not_retried_after_every_solve(tmp_path, monkeypatch):
     assert record_work(used, 1.0, background=False) == []
 
 
-def test_a_tier_up_build_writes_its_temporary_files_in_its_own_directory(tmp_path, monkeypatch):
+def test_a_tier_up_build_writes_its_temporary_files_in_its_own_directory(temp_keeping_compiler, monkeypatch):
     """gcc's temporary files of a tier-up build go into the build's working directory in the cache, which goes when
     the build ends, landed or failed: none reach the process's own ``TMPDIR``."""
-    cache, own_tmp = tmp_path / "cache", tmp_path / "tmp"
-    own_tmp.mkdir()
-    monkeypatch.setenv("DESIGNOPT_CACHE", str(cache))
-    monkeypatch.setenv("TMPDIR", str(own_tmp))
-    cc = tmp_path / "cc.sh"  # leaves a file in its temporary directory, as a killed gcc would
-    cc.write_text('#!/bin/sh\necho partial > "${TMPDIR:-/tmp}/cckept$$.s"\nexec gcc "$@"\n')
-    cc.chmod(0o755)
+    cache, own_tmp = temp_keeping_compiler
     x = ca.SX.sym("x", 2)
     used = []
     compiled(ca.Function("blk9", [x], [ca.exp(x[1]) * x[0]]), "tiered", used)
     monkeypatch.setenv("DESIGNOPT_TIER_UP_AFTER", "0")
-    monkeypatch.setenv("CC", str(cc))
     assert record_work(used, 1.0, background=False) == used
     assert library_at(_stem(used[0]), "O1").exists()
     assert not list(own_tmp.iterdir()) and not list(cache.glob("build-*")) and not list(cache.rglob("cckept*"))
