@@ -527,7 +527,7 @@ PRESETS: dict[str, Search] = {
     "default": DEFAULT,
     # a best design worth three times the wait: the default made three times independently, the best of the three
     # (`Search.draws`); what it reaches is estimated from the default's evaluation runs taken three at a time
-    # (docs/benchmarks.md "Search", "Independent draws")
+    # (docs/benchmarks.md "Search", "`thorough`: three draws")
     "thorough": replace(DEFAULT, draws=3),
     "paper": PAPER,
     # an existing arm whose starts cross singular configurations: few basins, so 4 cold starts on the full program,
