@@ -135,7 +135,7 @@ class LiftedNLP:
         self.x = ca.vertcat(x_direct, ca.vec(Lall))
         self.y_index = y_indices(n_d, n_m, N, direct.n_state)  # x-indices of y_k = (q_k, q_d), one row a waypoint
         Y = ca.horzcat(*[x_direct[list(row)] for row in self.y_index])
-        phi, C, R = terms.map(N)(Y, Lall, *waypoint_inputs(tp))
+        phi, C, R = terms.map(N)(Y, Lall, *waypoint_inputs(problem)[:3])
         self.f = ca.sum2(phi) + total(nlp.quadratic, x_direct)
         n_c = C.shape[0]
         rest = nlp.g[n_c * N :]

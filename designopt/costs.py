@@ -36,7 +36,8 @@ class Waypoint:
     Frames: B (robot base) unless a name ends in _W (workpiece). ``q`` moving joints, ``q_d`` design joints,
     ``T_BW`` the placement, ``p``/``z`` tool position (m) and tool axis, ``J`` the 6 x n_m geometric
     Jacobian, ``s_W``/``f_W`` the waypoint (m) and its process force (N) in W, ``force`` that force in B,
-    ``k_inv`` the inverse joint stiffnesses, ``deflection`` full or translational.
+    ``k_inv`` the inverse joint stiffnesses, ``deflection`` full or translational (or, in a symbolic waypoint,
+    the weights of the deflection's six rows: see `deflection_rows`).
     """
 
     q: object
@@ -48,8 +49,8 @@ class Waypoint:
     s_W: object
     f_W: object
     force: object
-    k_inv: np.ndarray
-    deflection: str
+    k_inv: object
+    deflection: object
 
     @property
     def p_W(self):
@@ -66,7 +67,7 @@ class Waypoint:
 Z_DOWN = np.array([0.0, 0.0, -1.0])  # the target tool axis in W: into the surface
 
 
-def waypoint(chain: Chain, q, q_d, s_W, f_W, k_inv, deflection: str) -> Waypoint:
+def waypoint(chain: Chain, q, q_d, s_W, f_W, k_inv, deflection) -> Waypoint:
     """The state at one waypoint from the chain's kinematics. The pose and the Jacobian walk the chain separately:
     sharing one walk changes the CasADi graph, and with it the default job's trajectory by ~2e-6 (measured)."""
     T_BW = placement_pose(chain, q, q_d)
@@ -209,11 +210,24 @@ def deflection(J, k_inv, force_B):
     return J @ (k_inv * (J[:3, :].T @ force_B))
 
 
-def deformation(J, k_inv, force_B, mode: str = "full"):
-    """L_d = |C w|^2 over all six rows (``full``, the paper) or the first three (``translational``)."""
+def deflection_rows(mode: str) -> np.ndarray:
+    """The weights (0 or 1) of the deflection's six rows (translation m, rotation rad) that L_d squares."""
     if mode not in DEFLECTION_MODES:
         raise ValueError(f"deflection must be one of {DEFLECTION_MODES}, got {mode!r}")
+    return np.array([1.0, 1.0, 1.0, *([1.0] * 3 if mode == "full" else [0.0] * 3)])
+
+
+def deformation(J, k_inv, force_B, mode="full"):
+    """L_d = |C w|^2 over all six rows (``full``, the paper) or the first three (``translational``).
+
+    ``mode`` may also be the six rows' weights as a CasADi symbol (`deflection_rows`' values given at run time), so
+    that one compiled block serves every stiffness and deflection model: L_d = |diag(rows) C w|^2.
+    """
     delta = deflection(J, k_inv, force_B)
+    if is_symbolic(mode):
+        return ca.sumsqr(mode * delta)
+    if mode not in DEFLECTION_MODES:
+        raise ValueError(f"deflection must be one of {DEFLECTION_MODES}, got {mode!r}")
     if mode == "translational":
         delta = delta[:3]
     if is_symbolic(delta):

@@ -18,6 +18,7 @@ import pytest
 
 from designopt import toolpaths
 from designopt.config import parse_config
+from designopt.costs import DesignCost
 from designopt.evaluation import evaluate
 from designopt.initial_guess import initial_guess
 from designopt.kinematics.joints import Role
@@ -25,7 +26,7 @@ from designopt.kinematics.transforms import placement_transform
 from designopt.problem import problem_from_config
 from designopt.solve import SolverProfile, solve_guess
 from designopt.transcriptions import Collocation
-from designopt.transcriptions.nlp import waypoint_terms
+from designopt.transcriptions.nlp import model_inputs, waypoint_terms
 from designopt.transcriptions.trajectory import PiecewiseLinear
 
 PROFILE = SolverProfile(max_iter=500, compile="none")
@@ -237,7 +238,7 @@ def test_optimizer_and_evaluation_agree_with_reference_at_random_points(deflecti
         placement = [values[f"placement.{p}"] for p in ("x", "y", "z", "yaw", "pitch", "roll")]
         p_ref, z_ref, L_ref = ref_waypoint(structure, dh, placement, q, s_W, f_W, [3.0, 0.2, 3, 3, 0.2, 3],
                                            deflection)
-        phi, c = terms(np.r_[q, q_d], s_W, f_W, [h, 1.0])
+        phi, c = terms(np.r_[q, q_d], s_W, f_W, [h, 1.0], *model_inputs(problem))
         c = np.array(c).ravel()
         np.testing.assert_allclose(c[:3], p_ref - s_W, atol=1e-12)
         np.testing.assert_allclose(c[3:6], z_ref, atol=1e-12)
@@ -261,6 +262,45 @@ def test_optimizer_and_evaluation_agree_with_reference_at_random_points(deflecti
         T_BW = ref_placement(*placement)  # the path's points in B: the stand-off is their least distance from z_B
         assert m.min_standoff == pytest.approx(min(np.hypot(*(T_BW[:3, :3] @ s + T_BW[:3, 3])[:2]) for s in S),
                                                rel=1e-10)
+
+
+def test_one_block_serves_every_stiffness_deflection_and_weight(rng):
+    """The per-waypoint terms take K^-1, the deflection's rows and the terms' weights as inputs: two models of one
+    robot and path have the same terms (the compile cache's key), and each model's inputs give its own cost."""
+    structure = "RRPR"
+    rows = [{"theta": rng.uniform(-3, 3), "d": rng.uniform(0, 0.5), "a": rng.uniform(0, 0.5),
+             "alpha": rng.uniform(-3, 3)} for _ in structure]
+    models = {"paper": ({}, "full", 1.0, [1.0] * 4),
+              "physical": ({"revolute": 3.0, "prismatic": 0.2}, "translational", 250.0, [3.0, 3.0, 0.2, 3.0])}
+    problems, terms = {}, {}
+    for name, (stiffness, deflection, weight, _) in models.items():
+        robot = {"structure": structure, "dh": rows, **({"stiffness": stiffness} if stiffness else {})}
+        cfg = parse_config({"robot": robot, "placement": {"xyz": [0.4, -0.3, 0.2], "ypr": [0.7, -0.4, 1.1]},
+                            "costs": {"deflection": deflection, "deformation_weight": weight},
+                            "toolpath": {"kind": "circle", "waypoints": 9}})
+        # a design term the per-waypoint terms carry (not quadratic), weighted differently per model
+        problems[name] = problem_from_config(cfg).with_cost(DesignCost("spread", weight / 50.0, _quartic))
+        terms[name] = waypoint_terms(problems[name], "hard")[0]
+    assert terms["paper"].serialize() == terms["physical"].serialize()
+    chain, h = problems["paper"].chain, problems["paper"].toolpath.dt
+    names = [j.name for j in chain.design]
+    q = rng.uniform(-2, 2, chain.n_moving)
+    q_d = np.array([rng.uniform(max(j.lower, -1), min(j.upper, 1)) for j in chain.design])
+    s_W, f_W = rng.normal(size=3), rng.normal(size=3)
+    values = dict(zip(names, q_d, strict=True))
+    dh = [{p: values.get(f"link{i + 1}.{p}", rows[i][p]) for p in ("theta", "d", "a", "alpha")}
+          for i in range(len(structure))]
+    placement = [values[f"placement.{p}"] for p in ("x", "y", "z", "yaw", "pitch", "roll")]
+    for name, (_, deflection, weight, k) in models.items():
+        L_ref = ref_waypoint(structure, dh, placement, q, s_W, f_W, k, deflection)[2]
+        phi, _ = terms["paper"](np.r_[q, q_d], s_W, f_W, [h, 1.0], *model_inputs(problems[name]))
+        spread = weight / 50.0 * (q_d[0] - 0.1) ** 4 / problems[name].toolpath.n
+        assert float(phi) == pytest.approx(h * weight * L_ref + spread, rel=1e-10)
+
+
+def _quartic(chain, q_d):
+    """A design term that is not quadratic: the per-waypoint terms carry it, spread over the waypoints."""
+    return (q_d[0] - 0.1) ** 4
 
 
 def test_symbolic_deformation_uses_inverse_stiffness():

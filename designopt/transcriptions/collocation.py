@@ -122,7 +122,8 @@ class CollocationNLP:
         M = ca.SX.sym("M", n_m, N - 1) if self.n_mid else None
         x = ca.vertcat(q_d, ca.vec(Z), *([ca.vec(M)] if self.n_mid else []))
         Q, V = Z[:n_m, :], Z[n_m : 2 * n_m, :]
-        S, F, K_w = waypoint_inputs(tp)
+        inputs = waypoint_inputs(problem)
+        S, F = inputs[0], inputs[1]
 
         terms, c_lo, c_hi = waypoint_terms(problem, scheme.tracking, position_in_terms=not differential)
 
@@ -134,7 +135,7 @@ class CollocationNLP:
                                                 np.full(N - 1, tp.dt) if tp.uniform else tp.h),
                      quadratic_terms.joint_regularization(problem, q_index, tp.weights))
         # the terms' graph over all waypoints: built only if the whole f or g is asked for, never for a solve
-        objective, C = deferred_terms(terms, ca.vertcat(Q, ca.repmat(q_d, 1, N)), (S, F, K_w), quadratic, x)
+        objective, C = deferred_terms(terms, ca.vertcat(Q, ca.repmat(q_d, 1, N)), inputs, quadratic, x)
 
         cons = ConstraintList()
         n_c = terms.size1_out(1)

@@ -86,7 +86,8 @@ class ForwardKinematicsNLP:
         quadratic = (quadratic_terms.joint_regularization(problem, q_index, tp.weights),
                      *quadratic_terms.design_costs(problem, np.arange(n_d)))
         # the terms' graph over all waypoints: built only if the whole f or g is asked for, never for a solve
-        objective, C = deferred_terms(terms, ca.vertcat(Q, ca.repmat(q_d, 1, N)), waypoint_inputs(tp), quadratic, x)
+        objective, C = deferred_terms(terms, ca.vertcat(Q, ca.repmat(q_d, 1, N)), waypoint_inputs(problem),
+                                      quadratic, x)
 
         cons = ConstraintList()
         n_c = terms.size1_out(1)

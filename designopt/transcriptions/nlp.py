@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from designopt.costs import tracking_residual
+from designopt.costs import deflection_rows, tracking_residual, waypoint
 from designopt.problem import DesignProblem
 from designopt.transcriptions.affine import Affine
 from designopt.transcriptions.compiled import built_together, compiled_as, level
@@ -144,7 +144,7 @@ class ConstraintList:
 @dataclass(frozen=True)
 class BlockStructure:
     """Where per-point terms sit: x indices of each y_k and lam_g indices of each c_k; ``inputs`` are the terms'
-    constant inputs after y (one column per point; None: the toolpath's `waypoint_inputs`)."""
+    constant inputs after y (one column per point; None: the problem's `waypoint_inputs`)."""
 
     terms: ca.Function
     y_index: np.ndarray
@@ -215,8 +215,8 @@ class NLP:
         return tuple(dict.fromkeys(self._tiered.get(compile_mode, ())))
 
     def _inputs(self, block: BlockStructure) -> list:
-        """A block's constant inputs, one column per point (the toolpath's `waypoint_inputs` unless it has its own)."""
-        return list(waypoint_inputs(self.problem.toolpath) if block.inputs is None else block.inputs)
+        """A block's constant inputs, one column per point (the problem's `waypoint_inputs` unless it has its own)."""
+        return list(waypoint_inputs(self.problem) if block.inputs is None else block.inputs)
 
     def hessian(self, compile_mode: str):
         """hess_lag(x, p, lam_f, lam_g) from the per-point blocks (each block function compiled per
@@ -394,11 +394,23 @@ def y_indices(n_d: int, n_m: int, N: int, stride: int) -> np.ndarray:
     return np.hstack([q_index, np.tile(np.arange(n_d), (N, 1))])
 
 
-def waypoint_inputs(toolpath):
-    """The per-waypoint constants of the terms function, one column per waypoint: s_W (3 x N), f_W (3 x N)
-    and (w_k, tracked_k) (2 x N): quadrature weight and whether the tool must follow the path there."""
+def waypoint_inputs(problem: DesignProblem):
+    """The constant inputs of `waypoint_terms`, one column per waypoint: the path's s_W (3 x N), f_W (3 x N) and
+    (w_k, tracked_k) (2 x N: quadrature weight, whether the tool must follow the path there), then the model's
+    `model_inputs`, the same in every column."""
+    toolpath = problem.toolpath
     k_w = np.vstack([toolpath.weights, toolpath.is_tracked.astype(float)])
-    return ca.DM(toolpath.points_W.T), ca.DM(toolpath.force_W.T), ca.DM(k_w)
+    model = [ca.DM(np.tile(np.asarray(v, dtype=float)[:, None], (1, toolpath.n))) for v in model_inputs(problem)]
+    return ca.DM(toolpath.points_W.T), ca.DM(toolpath.force_W.T), ca.DM(k_w), *model
+
+
+def model_inputs(problem: DesignProblem) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """What `waypoint_terms` takes as inputs rather than constants, so that its compiled blocks serve every
+    stiffness model, deflection mode and weighting of the same robot and path: K^-1 of the moving joints
+    (rad/(N*m) or m/N), the weight of each `WaypointCost` and each non-quadratic `DesignCost`, and the weights of
+    the deflection's six rows (`costs.deflection_rows`)."""
+    weights = [c.weight for c in problem.waypoint_costs] + [c.weight for c in problem.design_costs if not c.quadratic]
+    return problem.k_inv, np.array(weights, dtype=float), deflection_rows(problem.deflection)
 
 
 def free_untracked(problem: DesignProblem, lo: np.ndarray, hi: np.ndarray, rows: np.ndarray):
@@ -438,22 +450,26 @@ def waypoint_terms(problem: DesignProblem, activation: str, position_in_terms: b
     phi_k holds every `WaypointCost` (w_k * weight * fn), every non-quadratic `DesignCost` spread evenly over
     the waypoints (so that the per-waypoint blocks, and with them the exact structured Hessian, carry it) and,
     when soft, the tracking penalty (zero where the waypoint is not tracked). Returns the CasADi function
-    (y, s_W, f_W, k_w) -> (phi, c), with k_w = (w_k, tracked_k) (see `waypoint_inputs`), and the bounds of c.
-    Its first `tracking_rows` rows are the tracking constraints. The position enters only when p = FK(q); in
-    differential mode it is a state.
+    (y, s_W, f_W, k_w, k_inv, weights, rows) -> (phi, c), with k_w = (w_k, tracked_k) and the model's constants
+    (`waypoint_inputs`, `model_inputs`), and the bounds of c. Its first `tracking_rows` rows are the tracking
+    constraints. The position enters only when p = FK(q); in differential mode it is a state. With the model's
+    constants as inputs the block's values are those of the same terms with them as numbers, to the bit (a product
+    by 1 or a sum with 0 is exact), and its compiled blocks are shared by every model of one robot and path.
     """
     chain, tp = problem.chain, problem.toolpath
     n_m, n_d = chain.n_moving, chain.n_design
     y = ca.SX.sym("y", n_m + n_d)
     s_W, f_W, k_w = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3), ca.SX.sym("k_w", 2)
+    k_inv, rows = ca.SX.sym("k_inv", n_m), ca.SX.sym("rows", 6)
+    design_terms = [cost for cost in problem.design_costs if not cost.quadratic]
+    weights = ca.SX.sym("weights", len(problem.waypoint_costs) + len(design_terms))
     h, tracked = k_w[0], k_w[1]
-    w = problem.waypoint(y[:n_m], y[n_m:], s_W, f_W)
+    w = waypoint(chain, y[:n_m], y[n_m:], s_W, f_W, k_inv, rows)
     phi = 0
-    for cost in problem.waypoint_costs:
-        phi += h * cost.weight * cost.fn(w)
-    for cost in problem.design_costs:
-        if not cost.quadratic:
-            phi += cost(problem.chain, y[n_m:]) / tp.n
+    for i, cost in enumerate(problem.waypoint_costs):
+        phi += h * weights[i] * cost.fn(w)
+    for i, cost in enumerate(design_terms, len(problem.waypoint_costs)):
+        phi += weights[i] * cost.fn(chain, y[n_m:]) / tp.n
     penalty, c, lo, hi = tracking(w, s_W, activation, h * problem.tracking_weight, position_in_terms, epsilon)
     phi += tracked * penalty if activation == "soft" and not tp.is_tracked.all() else penalty
     if problem.keep_out_radius > 0:
@@ -461,8 +477,8 @@ def waypoint_terms(problem: DesignProblem, activation: str, position_in_terms: b
         c.append(s_B[0] ** 2 + s_B[1] ** 2)
         lo.append(problem.keep_out_radius**2)
         hi.append(np.inf)
-    fn = ca.Function("terms", [y, s_W, f_W, k_w], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
-                     ["y", "s_W", "f_W", "k_w"], ["phi", "c"])
+    fn = ca.Function("terms", [y, s_W, f_W, k_w, k_inv, weights, rows], [phi, ca.vertcat(*c) if c else ca.SX(0, 1)],
+                     ["y", "s_W", "f_W", "k_w", "k_inv", "weights", "rows"], ["phi", "c"])
     return fn, np.array(lo), np.array(hi)
 
 
