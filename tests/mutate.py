@@ -55,8 +55,10 @@ MUTATIONS = [
              "phi += weights[i] * cost.fn(chain, y[n_m:]) / tp.n", "phi += cost.fn(chain, y[n_m:]) / tp.n"),
     Mutation("the weights given to the terms in another order than they are read",
              "designopt/transcriptions/nlp.py",
-             "weights = [c.weight for c in problem.waypoint_costs] + [c.weight for c in problem.design_costs if not c.quadratic]",
-             "weights = [c.weight for c in problem.design_costs if not c.quadratic] + [c.weight for c in problem.waypoint_costs]"),
+             "weights = [c.weight for c in problem.waypoint_costs] + [c.weight for c in problem.design_costs if not "
+             "c.quadratic]",
+             "weights = [c.weight for c in problem.design_costs if not c.quadratic] + [c.weight for c in "
+             "problem.waypoint_costs]"),
     Mutation("the deflection's rows weighted the other way round", "designopt/costs.py",
              "*([1.0] * 3 if mode == \"full\" else [0.0] * 3)", "*([0.0] * 3 if mode == \"full\" else [1.0] * 3)"),
     Mutation("K instead of K^-1 (problem)", "designopt/problem.py",
