@@ -26,7 +26,7 @@ from iteration_split import logged_solve  # noqa: E402
 
 import designopt.transcriptions.nlp as nlp_module  # noqa: E402
 from designopt.config import load_config  # noqa: E402
-from designopt.costs import deflection  # noqa: E402
+from designopt.costs import deflection, waypoint  # noqa: E402
 from designopt.evaluation import evaluate  # noqa: E402
 from designopt.experiments.adapters import search_from_config  # noqa: E402
 from designopt.problem import problem_from_config  # noqa: E402
@@ -39,18 +39,18 @@ EXACT = nlp_module.block_hessian_function
 def gauss_newton_blocks(problem):
     """A block_hessian_function whose deformation part is 2 h w J_r^T J_r (the tracking waypoint blocks only)."""
     n_m, n_d = problem.chain.n_moving, problem.chain.n_design
-    weight = sum(c.weight for c in problem.waypoint_costs if c.name == "deformation")
+    index = [i for i, c in enumerate(problem.waypoint_costs) if c.name == "deformation"][0]
 
-    def block(terms, n_y, n_c, compile_mode):
+    def block(terms, n_y, n_c, compile_mode, used=None):
         if terms.name() != "terms" or n_y != n_m + n_d:
-            return EXACT(terms, n_y, n_c, compile_mode)
+            return EXACT(terms, n_y, n_c, compile_mode, used)
         y, sigma, mu = ca.SX.sym("y", n_y), ca.SX.sym("sigma"), ca.SX.sym("mu", n_c)
         params = [ca.SX.sym(terms.name_in(i), terms.sparsity_in(i)) for i in range(1, terms.n_in())]
-        s_W, f_W, k_w = params
+        s_W, f_W, k_w, k_inv, weights, rows = params  # `nlp.waypoint_terms`' inputs
         phi, c = terms(y, *params)
-        w = problem.waypoint(y[:n_m], y[n_m:], s_W, f_W)
-        r = deflection(w.J, w.k_inv, w.force)
-        r = r[:3] if problem.deflection == "translational" else r
+        w = waypoint(problem.chain, y[:n_m], y[n_m:], s_W, f_W, k_inv, rows)
+        r = rows * deflection(w.J, k_inv, w.force)
+        weight = weights[index]
         phi_def = k_w[0] * weight * ca.sumsqr(r)
         exact_rest = ca.hessian(sigma * (phi - phi_def) + (ca.dot(mu, c) if n_c else 0), y)[0]
         J_r = ca.jacobian(r, y)
