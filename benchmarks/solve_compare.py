@@ -4,7 +4,8 @@ iteration, and whether the solves are the same to the bit.
 The revision's ``designopt/`` is exported (``git archive``) to a temporary directory and imported from there
 (``PYTHONPATH``) by the same venv, so a change to the Python library, to a compiled block or to the LDLᵀ's C sources
 (built into the compile cache under their own key) is measured alike, without a second venv. Each round runs, in
-one fresh process per checkout (alternating, so that the machine's load falls on both alike), ``--starts`` seeded
+one fresh process per checkout (alternating, in the order ABBA, so that the machine's load and which one runs
+second fall on both alike), ``--starts`` seeded
 starts of ``--config`` as the search solves them (``--waypoints`` > 0: the exploration's, capped, watched, by its
 linear solver; 0: cold starts on the full path by the search's profile; `speed_table.setup`), and prints each
 process's CPU per iteration, the iterations and a digest of the objectives and solutions reached: equal digests
@@ -82,7 +83,7 @@ def compare_builds(against: str, config: str, rounds: int) -> None:
         both = checkouts(against, tmp)
         for r in range(rounds + 1):  # round 0 fills the compile cache for both
             row = {}
-            for name, env in both:
+            for name, env in (both if r % 2 == 0 else both[::-1]):
                 out = subprocess.run(command, check=True, capture_output=True, text=True, cwd=ROOT, env=env)
                 row[name] = tuple(float(v) for v in out.stdout.split()[-2:])
                 if r:
@@ -121,7 +122,7 @@ def main() -> None:
         ratios, digests = [], set()
         for r in range(args.rounds):
             row = {}
-            for name, env in both:
+            for name, env in (both if r % 2 == 0 else both[::-1]):  # ABBA: neither checkout always runs second
                 out = subprocess.run(command, check=True, capture_output=True, text=True, cwd=ROOT, env=env)
                 ms, iterations, digest = out.stdout.split()[-3:]
                 row[name] = (float(ms), int(iterations), digest)
