@@ -227,15 +227,8 @@ def test_optimizer_and_evaluation_agree_with_reference_at_random_points(deflecti
     chain, h = problem.chain, problem.toolpath.dt
     # the optimizer's per-waypoint function: phi = dt * L_d (+ nothing else here), c = (p_W - s_W, z_W)
     terms, _, _ = waypoint_terms(problem, "hard")
-    names = [j.name for j in chain.design]
     for _ in range(5):
-        q = rng.uniform(-2, 2, chain.n_moving)
-        q_d = np.array([rng.uniform(max(j.lower, -1), min(j.upper, 1)) for j in chain.design])
-        s_W, f_W = rng.normal(size=3), rng.normal(size=3)
-        values = dict(zip(names, q_d, strict=True))
-        dh = [{p: values.get(f"link{i + 1}.{p}", rows[i][p]) for p in ("theta", "d", "a", "alpha")}
-              for i in range(len(structure))]
-        placement = [values[f"placement.{p}"] for p in ("x", "y", "z", "yaw", "pitch", "roll")]
+        q, q_d, s_W, f_W, dh, placement = _random_point(rng, chain, rows)
         p_ref, z_ref, L_ref = ref_waypoint(structure, dh, placement, q, s_W, f_W, [3.0, 0.2, 3, 3, 0.2, 3],
                                            deflection)
         phi, c = terms(np.r_[q, q_d], s_W, f_W, [h, 1.0], *model_inputs(problem))
@@ -283,19 +276,26 @@ def test_one_block_serves_every_stiffness_deflection_and_weight(rng):
         terms[name] = waypoint_terms(problems[name], "hard")[0]
     assert terms["paper"].serialize() == terms["physical"].serialize()
     chain, h = problems["paper"].chain, problems["paper"].toolpath.dt
-    names = [j.name for j in chain.design]
-    q = rng.uniform(-2, 2, chain.n_moving)
-    q_d = np.array([rng.uniform(max(j.lower, -1), min(j.upper, 1)) for j in chain.design])
-    s_W, f_W = rng.normal(size=3), rng.normal(size=3)
-    values = dict(zip(names, q_d, strict=True))
-    dh = [{p: values.get(f"link{i + 1}.{p}", rows[i][p]) for p in ("theta", "d", "a", "alpha")}
-          for i in range(len(structure))]
-    placement = [values[f"placement.{p}"] for p in ("x", "y", "z", "yaw", "pitch", "roll")]
+    q, q_d, s_W, f_W, dh, placement = _random_point(rng, chain, rows)
     for name, (_, deflection, weight, k) in models.items():
         L_ref = ref_waypoint(structure, dh, placement, q, s_W, f_W, k, deflection)[2]
         phi, _ = terms["paper"](np.r_[q, q_d], s_W, f_W, [h, 1.0], *model_inputs(problems[name]))
         spread = weight / 50.0 * (q_d[0] - 0.1) ** 4 / problems[name].toolpath.n
         assert float(phi) == pytest.approx(h * weight * L_ref + spread, rel=1e-10)
+
+
+def _random_point(rng, chain, rows):
+    """Random joints, design joints (within their bounds, |v| <= 1), waypoint and force, and the DH rows and
+    placement of that design for the numpy reference (``rows``: the configured DH rows, a design joint replaces its
+    entry)."""
+    q = rng.uniform(-2, 2, chain.n_moving)
+    q_d = np.array([rng.uniform(max(j.lower, -1), min(j.upper, 1)) for j in chain.design])
+    s_W, f_W = rng.normal(size=3), rng.normal(size=3)
+    values = dict(zip([j.name for j in chain.design], q_d, strict=True))
+    dh = [{p: values.get(f"link{i + 1}.{p}", row[p]) for p in ("theta", "d", "a", "alpha")}
+          for i, row in enumerate(rows)]
+    placement = [values[f"placement.{p}"] for p in ("x", "y", "z", "yaw", "pitch", "roll")]
+    return q, q_d, s_W, f_W, dh, placement
 
 
 def _quartic(chain, q_d):
