@@ -67,6 +67,21 @@ def test_structured_hessian_carries_the_term(problems, rng):
                                    np.triu(np.array(ca.DM(H_ref(x, [], 1.3, lam_g)))), rtol=1e-9, atol=1e-9)
 
 
+def test_a_problem_without_a_waypoint_term_builds_its_blocks(problems, rng):
+    """Every per-waypoint term dropped (the terms' weights input then has no rows): the compiled structured Hessian
+    is still CasADi's own."""
+    base, _ = problems
+    bare = base.without_cost("deformation")
+    assert not bare.waypoint_costs
+    _, ours, _ = prepared(bare, Collocation(hessian="structured"), SolverProfile(compile="O0"))
+    _, ref, _ = prepared(bare, Collocation(hessian="auto"), SolverProfile())
+    H_ours, H_ref = ours.solver.get_function("nlp_hess_l"), ref.solver.get_function("nlp_hess_l")
+    for _ in range(2):
+        x, lam_g = rng.normal(size=ours.nlp.n_variables), rng.normal(size=ours.nlp.n_constraints)
+        np.testing.assert_allclose(np.triu(np.array(ca.DM(H_ours(x, [], 1.3, lam_g)))),
+                                   np.triu(np.array(ca.DM(H_ref(x, [], 1.3, lam_g)))), rtol=1e-9, atol=1e-9)
+
+
 def test_the_term_is_a_column_and_a_file_metric(problems, tmp_path):
     _, extended = problems
     run = RunDirectory(tmp_path / "run")
