@@ -212,9 +212,14 @@ def deflection(J, k_inv, force_B):
 
 def deflection_rows(mode: str) -> np.ndarray:
     """The weights (0 or 1) of the deflection's six rows (translation m, rotation rad) that L_d squares."""
+    return np.array([1.0, 1.0, 1.0, *([1.0] * 3 if _known(mode) == "full" else [0.0] * 3)])
+
+
+def _known(mode: str) -> str:
+    """``mode`` if it is a deflection mode (`DEFLECTION_MODES`), else a ValueError naming the modes."""
     if mode not in DEFLECTION_MODES:
         raise ValueError(f"deflection must be one of {DEFLECTION_MODES}, got {mode!r}")
-    return np.array([1.0, 1.0, 1.0, *([1.0] * 3 if mode == "full" else [0.0] * 3)])
+    return mode
 
 
 def deformation(J, k_inv, force_B, mode="full"):
@@ -226,9 +231,7 @@ def deformation(J, k_inv, force_B, mode="full"):
     delta = deflection(J, k_inv, force_B)
     if is_symbolic(mode):
         return ca.sumsqr(mode * delta)
-    if mode not in DEFLECTION_MODES:
-        raise ValueError(f"deflection must be one of {DEFLECTION_MODES}, got {mode!r}")
-    if mode == "translational":
+    if _known(mode) == "translational":
         delta = delta[:3]
     if is_symbolic(delta):
         return ca.sumsqr(delta)

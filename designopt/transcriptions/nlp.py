@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from designopt.costs import deflection_rows, tracking_residual, waypoint
+from designopt.costs import DesignCost, WaypointCost, deflection_rows, tracking_residual, waypoint
 from designopt.problem import DesignProblem
 from designopt.transcriptions.affine import Affine
 from designopt.transcriptions.compiled import built_together, compiled_as, level
@@ -409,8 +409,14 @@ def model_inputs(problem: DesignProblem) -> tuple[np.ndarray, np.ndarray, np.nda
     stiffness model, deflection mode and weighting of the same robot and path: K^-1 of the moving joints
     (rad/(N*m) or m/N), the weight of each `WaypointCost` and each non-quadratic `DesignCost`, and the weights of
     the deflection's six rows (`costs.deflection_rows`)."""
-    weights = [c.weight for c in problem.waypoint_costs] + [c.weight for c in problem.design_costs if not c.quadratic]
-    return problem.k_inv, np.array(weights, dtype=float), deflection_rows(problem.deflection)
+    weights = np.array([cost.weight for cost in weighted_terms(problem)], dtype=float)
+    return problem.k_inv, weights, deflection_rows(problem.deflection)
+
+
+def weighted_terms(problem: DesignProblem) -> tuple[WaypointCost | DesignCost, ...]:
+    """The terms `waypoint_terms` carries, in the order of its ``weights`` input: every `WaypointCost`, then every
+    non-quadratic `DesignCost` (spread over the waypoints; the quadratic ones have a constant Hessian of their own)."""
+    return (*problem.waypoint_costs, *(cost for cost in problem.design_costs if not cost.quadratic))
 
 
 def free_untracked(problem: DesignProblem, lo: np.ndarray, hi: np.ndarray, rows: np.ndarray):
@@ -461,15 +467,16 @@ def waypoint_terms(problem: DesignProblem, activation: str, position_in_terms: b
     y = ca.SX.sym("y", n_m + n_d)
     s_W, f_W, k_w = ca.SX.sym("s_W", 3), ca.SX.sym("f_W", 3), ca.SX.sym("k_w", 2)
     k_inv, rows = ca.SX.sym("k_inv", n_m), ca.SX.sym("rows", 6)
-    design_terms = [cost for cost in problem.design_costs if not cost.quadratic]
-    weights = ca.SX.sym("weights", len(problem.waypoint_costs) + len(design_terms))
+    terms = weighted_terms(problem)
+    weights = ca.SX.sym("weights", len(terms))
     h, tracked = k_w[0], k_w[1]
     w = waypoint(chain, y[:n_m], y[n_m:], s_W, f_W, k_inv, rows)
     phi = 0
-    for i, cost in enumerate(problem.waypoint_costs):
-        phi += h * weights[i] * cost.fn(w)
-    for i, cost in enumerate(design_terms, len(problem.waypoint_costs)):
-        phi += weights[i] * cost.fn(chain, y[n_m:]) / tp.n
+    for i, cost in enumerate(terms):
+        if isinstance(cost, WaypointCost):
+            phi += h * weights[i] * cost.fn(w)
+        else:
+            phi += weights[i] * cost.fn(chain, y[n_m:]) / tp.n
     penalty, c, lo, hi = tracking(w, s_W, activation, h * problem.tracking_weight, position_in_terms, epsilon)
     phi += tracked * penalty if activation == "soft" and not tp.is_tracked.all() else penalty
     if problem.keep_out_radius > 0:
